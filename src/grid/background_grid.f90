@@ -1,0 +1,139 @@
+!> The part of the background grid a rank works on: the nodes of its owned cells.
+!>
+!> Nodes are numbered locally in one flat index, x fastest:
+!>   node(i, j, k) = 1 + (i - node_lo(1)) + n_nodes(1) * ((j - node_lo(2)) + n_nodes(2) * (k - node_lo(3)))
+!> with global 0-based node indices i, j, k. Cells use the same rule with their own counts. Nodal
+!> quantities that particles accumulate (P2G) live in one array `accumulated(:, node)` so that the
+!> ghost-node sum exchanges them all in one message.
+module background_grid
+   use kinds, only: rp
+   use shape_functions, only: n_corners, corner_offset
+   use domain_decomposition, only: domain_t
+   implicit none
+   private
+
+   !> Rows of `accumulated`: mass, then momentum (dim), then force (dim).
+   integer, parameter, public :: row_mass = 1
+
+   type, public :: grid_t
+      integer :: dim = 2
+      real(rp) :: h = 1.0_rp, inv_h = 1.0_rp       !< cell edge and its inverse
+      real(rp) :: origin(3) = 0.0_rp               !< lower corner of the whole grid (grid frame)
+      integer :: global_cells(3) = 1
+      integer :: node_lo(3) = 0, node_hi(3) = 0    !< global index range of the local nodes
+      integer :: n_nodes(3) = 1, node_count = 0
+      integer :: cell_lo(3) = 0, cell_hi(3) = 0    !< owned cells (global, 0-based)
+      integer :: n_cells(3) = 1, cell_count = 0
+      integer :: corner_stride(8) = 0              !< local node offset of corner a from the cell's lower node
+      integer :: row_momentum = 2, row_force = 4, n_rows = 5
+      real(rp), allocatable :: accumulated(:, :)   !< (n_rows, node): mass, momentum, force
+      real(rp), allocatable :: velocity(:, :)      !< v_i^{n+theta} used for kinematics and positions
+      real(rp), allocatable :: velocity_increment(:, :)  !< dv_i = v_i^{n+1} - v_i^n (FLIP increment)
+   contains
+      procedure :: init => grid_init
+      procedure :: local_node => grid_local_node
+      procedure :: local_cell => grid_local_cell
+      procedure :: base_node_of_cell => grid_base_node_of_cell
+      procedure :: cell_of_position => grid_cell_of_position
+      procedure :: cell_along => grid_cell_along
+   end type grid_t
+
+contains
+
+   !> Size the local node box from the owned cells of `domain`.
+   subroutine grid_init(self, domain, origin, h)
+      class(grid_t), intent(inout) :: self
+      type(domain_t), intent(in) :: domain
+      real(rp), intent(in) :: origin(3), h
+      integer :: a, k, stride(3)
+
+      self%dim = domain%dim
+      self%h = h
+      self%inv_h = 1.0_rp / h
+      self%origin = origin
+      self%global_cells = domain%global_cells
+      self%cell_lo = domain%cell_lo
+      self%cell_hi = domain%cell_hi
+      self%n_cells = 1
+      self%n_cells(1:self%dim) = self%cell_hi(1:self%dim) - self%cell_lo(1:self%dim) + 1
+      self%cell_count = product(self%n_cells)
+      self%node_lo = self%cell_lo
+      self%node_hi = self%cell_hi
+      self%node_hi(1:self%dim) = self%cell_hi(1:self%dim) + 1
+      self%n_nodes = 1
+      self%n_nodes(1:self%dim) = self%n_cells(1:self%dim) + 1
+      self%node_count = product(self%n_nodes)
+
+      stride = [1, self%n_nodes(1), self%n_nodes(1) * self%n_nodes(2)]
+      self%corner_stride = 0
+      do a = 1, n_corners(self%dim)
+         do k = 1, self%dim
+            self%corner_stride(a) = self%corner_stride(a) + corner_offset(a, k) * stride(k)
+         end do
+      end do
+
+      self%row_momentum = row_mass + 1
+      self%row_force = self%row_momentum + self%dim
+      self%n_rows = 1 + 2 * self%dim
+      if (allocated(self%accumulated)) deallocate (self%accumulated, self%velocity, self%velocity_increment)
+      allocate (self%accumulated(self%n_rows, self%node_count))
+      allocate (self%velocity(self%dim, self%node_count), self%velocity_increment(self%dim, self%node_count))
+      self%accumulated = 0.0_rp
+      self%velocity = 0.0_rp
+      self%velocity_increment = 0.0_rp
+   end subroutine grid_init
+
+   !> Local flat index of the node with global indices g (0-based).
+   pure integer function grid_local_node(self, g)
+      class(grid_t), intent(in) :: self
+      integer, intent(in) :: g(:)
+      integer :: k
+      grid_local_node = 0
+      do k = self%dim, 1, -1
+         grid_local_node = grid_local_node * self%n_nodes(k) + (g(k) - self%node_lo(k))
+      end do
+      grid_local_node = grid_local_node + 1
+   end function grid_local_node
+
+   !> Local flat index of the owned cell with global indices c (0-based).
+   pure integer function grid_local_cell(self, c)
+      class(grid_t), intent(in) :: self
+      integer, intent(in) :: c(:)
+      integer :: k
+      grid_local_cell = 0
+      do k = self%dim, 1, -1
+         grid_local_cell = grid_local_cell * self%n_cells(k) + (c(k) - self%cell_lo(k))
+      end do
+      grid_local_cell = grid_local_cell + 1
+   end function grid_local_cell
+
+   !> Local index of the lower corner node of the cell with global indices c.
+   pure integer function grid_base_node_of_cell(self, c)
+      class(grid_t), intent(in) :: self
+      integer, intent(in) :: c(:)
+      grid_base_node_of_cell = self%local_node(c)
+   end function grid_base_node_of_cell
+
+   !> Global cell (0-based) holding position x: floor((x - origin)/h), a particle on a face going to
+   !> the upper cell, except on the upper face of the whole grid, which belongs to the last cell.
+   pure function grid_cell_of_position(self, x) result(c)
+      class(grid_t), intent(in) :: self
+      real(rp), intent(in) :: x(:)
+      integer :: c(3), k
+      c = 0
+      do k = 1, self%dim
+         c(k) = self%cell_along(x(k), k)
+      end do
+   end function grid_cell_of_position
+
+   !> Global cell index along axis k of coordinate xk (rule of cell_of_position).
+   pure integer function grid_cell_along(self, xk, k) result(c)
+      class(grid_t), intent(in) :: self
+      real(rp), intent(in) :: xk
+      integer, intent(in) :: k
+      real(rp) :: s
+      s = (xk - self%origin(k)) * self%inv_h
+      c = floor(s)
+      if (c == self%global_cells(k) .and. s <= real(self%global_cells(k), rp) * (1 + epsilon(s))) c = c - 1
+   end function grid_cell_along
+end module background_grid

@@ -1,0 +1,77 @@
+!> What a scene declares: the values read from the namelist groups of a scene file
+!> (documented group by group in docs/input.md). Only what is declared is modelled.
+module scene_description
+   use kinds, only: rp, i8, path_len, name_len
+   implicit none
+   private
+
+   !> Wall condition keywords of the box sides (`&box_walls`).
+   character(len=*), parameter, public :: wall_none = 'none'
+   character(len=*), parameter, public :: wall_slip = 'slip'      ! [Y17] eq. 14, unilateral, frictionless
+   character(len=*), parameter, public :: wall_no_slip = 'no_slip'
+
+   !> Material model keywords (`&material model=`).
+   character(len=*), parameter, public :: model_newtonian_fluid = 'newtonian_fluid'
+   character(len=*), parameter, public :: model_linear_elastic = 'linear_elastic'
+
+   !> `&run`: time stepping, update scheme and output control.
+   type, public :: run_control_t
+      real(rp) :: end_time = -1.0_rp          !< simulated time to reach [s] (required)
+      real(rp) :: cfl = 0.5_rp                !< Courant number of the automatic time step
+      real(rp) :: fixed_dt = 0.0_rp           !< fixed time step [s]; 0 selects the CFL step
+      real(rp) :: output_interval = 0.0_rp    !< simulated time between diagnostics rows [s]; 0: end_time/100
+      character(len=path_len) :: output_dir = 'output'
+      logical :: overwrite = .false.          !< allow replacing a previous run in output_dir
+      character(len=name_len) :: update_scheme = 'MUSL'  !< 'MUSL' (default) or 'USL'
+      real(rp) :: flip_fraction = 1.0_rp      !< 1: pure FLIP, 0: pure PIC
+      real(rp) :: theta = 1.0_rp              !< theta of the nodal velocity used for kinematics
+      integer(i8) :: max_steps = huge(1_i8)   !< stop after this many steps
+      real(rp) :: progress_interval = 5.0_rp  !< wall seconds between progress lines on stderr; <= 0: none
+      real(rp) :: floor_size = 0.0_rp         !< tank floor width (2-D) / area (3-D) for h_eq; 0: from grid
+   end type run_control_t
+
+   !> `&grid` and `&box_walls`: the background grid in its own frame, and its walls.
+   type, public :: grid_spec_t
+      integer :: dim = 2                      !< 2 (plane strain) or 3
+      real(rp) :: cell_size = 0.0_rp          !< cell edge h [m]
+      real(rp) :: origin(3) = 0.0_rp          !< lower corner [m]
+      real(rp) :: extent(3) = 0.0_rp          !< edge lengths [m], whole multiples of cell_size
+      integer :: ncells(3) = 1                !< derived: extent / cell_size (1 on unused axes)
+      !> wall condition per side: (1, k) lower side, (2, k) upper side of axis k
+      character(len=name_len) :: wall(2, 3) = wall_none
+   end type grid_spec_t
+
+   !> `&material`: one constitutive model and its parameters.
+   type, public :: material_spec_t
+      character(len=name_len) :: name = ''
+      character(len=name_len) :: model = ''
+      real(rp) :: density = 0.0_rp            !< reference density [kg/m^3]
+      real(rp) :: bulk_modulus = 0.0_rp       !< fluid K [Pa]
+      real(rp) :: viscosity = 0.0_rp          !< fluid dynamic viscosity mu [Pa s]
+      real(rp) :: youngs_modulus = 0.0_rp     !< solid E [Pa]
+      real(rp) :: poisson_ratio = 0.0_rp      !< solid nu [-]
+      character(len=name_len) :: stabilization = 'none'   !< anti-locking / smoothing scheme
+   end type material_spec_t
+
+   !> `&body`: a rectangle (2-D) or box (3-D) of one material filled with particles.
+   type, public :: body_spec_t
+      character(len=name_len) :: material = ''
+      integer :: material_index = 0           !< derived: position in scene%materials
+      real(rp) :: lower(3) = 0.0_rp           !< lower corner [m]
+      real(rp) :: upper(3) = 0.0_rp           !< upper corner [m]
+      integer :: particles_per_cell = 2       !< particles per cell per direction
+      real(rp) :: velocity(3) = 0.0_rp        !< initial velocity [m/s]
+      logical :: hydrostatic = .false.        !< start from the hydrostatic stress of a fluid at rest
+      real(rp) :: free_surface_level = 0.0_rp !< height of the free surface along -gravity [m]
+   end type body_spec_t
+
+   !> A whole scene.
+   type, public :: scene_t
+      character(len=path_len) :: source_file = ''
+      type(run_control_t) :: run
+      type(grid_spec_t) :: grid
+      real(rp) :: gravity(3) = 0.0_rp         !< `&gravity acceleration=` [m/s^2]
+      type(material_spec_t), allocatable :: materials(:)
+      type(body_spec_t), allocatable :: bodies(:)
+   end type scene_t
+end module scene_description

@@ -1,0 +1,675 @@
+!> Reads a scene file of Fortran namelists (docs/input.md): rank 0 reads and checks it, then every
+!> rank receives the same scene and the same status (style.md, lesson 9).
+!>
+!> The file is read in layers that could later be repeated for an override file: a text pre-scan
+!> (`namelist_scan`) that knows every group and its lines, the namelist reads of the singleton groups
+!> (which start from the scene's current values), the repeated groups, the checks that the base file
+!> gives every required variable, and finally `validate_scene` / `resolve_scene` on the whole scene.
+module scene_reader
+   use, intrinsic :: iso_fortran_env, only: iostat_end
+   use mpi_f08, only: MPI_Comm, MPI_Comm_rank
+   use kinds, only: rp, i8, path_len
+   use error_status, only: status_t
+   use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, &
+                                model_newtonian_fluid, model_linear_elastic
+   use namelist_scan, only: namelist_file_t, namelist_group_t, scan_namelist_file
+   use scene_validation, only: validate_scene, resolve_scene, stabilization_keywords
+   use scene_broadcast, only: broadcast_scene, broadcast_scene_status
+   use input_text, only: lower_case, upper_case, int_text, ordinal, group_context, canonical_keyword
+   implicit none
+   private
+
+   public :: read_scene
+
+   !> The rank of `comm` that reads the file.
+   integer, parameter :: root = 0
+
+   character(len=*), parameter :: known_groups(*) = &
+      [character(len=9) :: 'run', 'grid', 'box_walls', 'gravity', 'material', 'body']
+   !> Groups that may appear at most once.
+   character(len=*), parameter :: singleton_groups(*) = [character(len=9) :: 'run', 'grid', 'box_walls', 'gravity']
+   !> Groups that may appear any number of times, one scene entry each.
+   character(len=*), parameter :: repeated_groups(*) = [character(len=8) :: 'material', 'body']
+   !> Groups a scene file must contain.
+   character(len=*), parameter :: required_groups(*) = [character(len=8) :: 'run', 'grid', 'material', 'body']
+
+   !> The variables of every group: their kind names the expected value in messages.
+   type :: variable_info_t
+      character(len=9) :: group
+      character(len=18) :: name
+      character(len=7) :: kind          !< real, real3, integer, logical or string
+      logical :: required
+   end type variable_info_t
+
+   type(variable_info_t), parameter :: variables(*) = [ &
+      variable_info_t('run', 'end_time', 'real', .true.), &
+      variable_info_t('run', 'cfl', 'real', .false.), &
+      variable_info_t('run', 'dt', 'real', .false.), &
+      variable_info_t('run', 'output_interval', 'real', .false.), &
+      variable_info_t('run', 'output_dir', 'string', .false.), &
+      variable_info_t('run', 'overwrite', 'logical', .false.), &
+      variable_info_t('run', 'update_scheme', 'string', .false.), &
+      variable_info_t('run', 'flip_fraction', 'real', .false.), &
+      variable_info_t('run', 'theta', 'real', .false.), &
+      variable_info_t('run', 'max_steps', 'integer', .false.), &
+      variable_info_t('run', 'progress_interval', 'real', .false.), &
+      variable_info_t('run', 'floor_size', 'real', .false.), &
+      variable_info_t('grid', 'dim', 'integer', .false.), &
+      variable_info_t('grid', 'cell_size', 'real', .true.), &
+      variable_info_t('grid', 'origin', 'real3', .false.), &
+      variable_info_t('grid', 'extent', 'real3', .true.), &
+      variable_info_t('box_walls', 'x_min', 'string', .false.), &
+      variable_info_t('box_walls', 'x_max', 'string', .false.), &
+      variable_info_t('box_walls', 'y_min', 'string', .false.), &
+      variable_info_t('box_walls', 'y_max', 'string', .false.), &
+      variable_info_t('box_walls', 'z_min', 'string', .false.), &
+      variable_info_t('box_walls', 'z_max', 'string', .false.), &
+      variable_info_t('gravity', 'acceleration', 'real3', .false.), &
+      variable_info_t('material', 'name', 'string', .true.), &
+      variable_info_t('material', 'model', 'string', .true.), &
+      variable_info_t('material', 'density', 'real', .true.), &
+      variable_info_t('material', 'bulk_modulus', 'real', .false.), &
+      variable_info_t('material', 'viscosity', 'real', .false.), &
+      variable_info_t('material', 'youngs_modulus', 'real', .false.), &
+      variable_info_t('material', 'poisson_ratio', 'real', .false.), &
+      variable_info_t('material', 'stabilization', 'string', .false.), &
+      variable_info_t('body', 'material', 'string', .true.), &
+      variable_info_t('body', 'lower', 'real3', .true.), &
+      variable_info_t('body', 'upper', 'real3', .true.), &
+      variable_info_t('body', 'particles_per_cell', 'integer', .false.), &
+      variable_info_t('body', 'velocity', 'real3', .false.), &
+      variable_info_t('body', 'hydrostatic', 'logical', .false.), &
+      variable_info_t('body', 'free_surface_level', 'real', .false.)]
+
+   !> Namelist buffers of string values are longer than the scene's fields, so that a value too long
+   !> for its field is reported instead of cut.
+   integer, parameter :: text_len = 2*path_len
+   !> iostat of a group read whose string value is too long for its field (no run-time library uses it).
+   integer, parameter :: value_too_long = huge(1)
+
+contains
+
+   !> Read the scene file `path`. Collective over `comm`: rank 0 reads and checks the file, then the
+   !> status and (if it is ok) the scene are broadcast, so that every rank returns the same status and
+   !> the same scene. On failure the scene is the default scene_t on every rank.
+   subroutine read_scene(path, comm, scene, status)
+      character(len=*), intent(in) :: path
+      type(MPI_Comm), intent(in) :: comm
+      type(scene_t), intent(out) :: scene
+      type(status_t), intent(out) :: status
+      type(scene_t) :: empty_scene
+      integer :: rank
+
+      call MPI_Comm_rank(comm, rank)
+      if (rank == root) then
+         call load_scene_file(path, scene, status)
+         if (status%ok) call validate_scene(scene, trim(path), status)
+         if (status%ok) call resolve_scene(scene)
+      end if
+      call broadcast_scene_status(status, comm, root)
+      if (status%ok) then
+         call broadcast_scene(scene, comm, root)
+      else
+         scene = empty_scene
+      end if
+   end subroutine read_scene
+
+   !> Serial part of `read_scene`: open `path` and read every group into `scene`.
+   subroutine load_scene_file(path, scene, status)
+      character(len=*), intent(in) :: path
+      type(scene_t), intent(inout) :: scene
+      type(status_t), intent(inout) :: status
+      character(len=512) :: message
+      logical :: exists, is_directory
+      integer :: unit, ios
+
+      if (len_trim(path) == 0) then
+         call status%fail('no scene file given')
+         return
+      else if (len_trim(path) > path_len) then
+         call status%fail(trim(path)//': the path of the scene file is longer than '//int_text(path_len)//' characters')
+         return
+      end if
+      inquire (file=trim(path), exist=exists)
+      if (.not. exists) then
+         call status%fail(trim(path)//': scene file not found')
+         return
+      end if
+      inquire (file=trim(path)//'/.', exist=is_directory)
+      if (is_directory) then
+         call status%fail(trim(path)//': is a directory, not a scene file')
+         return
+      end if
+      open (newunit=unit, file=trim(path), status='old', action='read', form='formatted', access='sequential', &
+            iostat=ios, iomsg=message)
+      if (ios /= 0) then
+         call status%fail(trim(path)//': cannot open the scene file: '//trim(message))
+         return
+      end if
+      scene%source_file = path
+      call read_base_file(unit, trim(path), scene, status)
+      close (unit)
+   end subroutine load_scene_file
+
+   !> Read the scene file open on `unit`: every required group and variable must be there.
+   subroutine read_base_file(unit, path, scene, status)
+      integer, intent(in) :: unit
+      character(len=*), intent(in) :: path
+      type(scene_t), intent(inout) :: scene
+      type(status_t), intent(inout) :: status
+      type(namelist_file_t) :: file
+      integer :: g
+
+      call scan_namelist_file(unit, path, known_groups, file, status)
+      if (.not. status%ok) return
+      call check_group_counts(file, status)
+      if (.not. status%ok) return
+      do g = 1, size(required_groups)
+         if (file%count(required_groups(g)) == 0) then
+            call status%fail(path//': group &'//trim(required_groups(g))//' is required but missing')
+            return
+         end if
+      end do
+      call read_singleton_groups(unit, file, scene, status)
+      if (.not. status%ok) return
+      call read_repeated_groups(unit, file, scene, status)
+      if (.not. status%ok) return
+      call check_required_variables(file, scene, status)
+   end subroutine read_base_file
+
+   !> A singleton group may appear at most once.
+   subroutine check_group_counts(file, status)
+      type(namelist_file_t), intent(in) :: file
+      type(status_t), intent(inout) :: status
+      integer :: g, n
+      do g = 1, size(singleton_groups)
+         n = file%count(singleton_groups(g))
+         if (n > 1) then
+            call status%fail(file%path//': group &'//trim(singleton_groups(g))//' appears '//int_text(n)// &
+                             ' times (lines '//int_text(file%groups(file%find(singleton_groups(g), 1))%first_line)// &
+                             ' and '//int_text(file%groups(file%find(singleton_groups(g), 2))%first_line)// &
+                             '); it may appear only once')
+            return
+         end if
+      end do
+   end subroutine check_group_counts
+
+   !> Read every singleton group present in the file. Each read starts from the values the scene
+   !> already holds, so a second file could override some of them.
+   subroutine read_singleton_groups(unit, file, scene, status)
+      integer, intent(in) :: unit
+      type(namelist_file_t), intent(in) :: file
+      type(scene_t), intent(inout) :: scene
+      type(status_t), intent(inout) :: status
+      character(len=512) :: message
+      integer :: g, ios
+
+      do g = 1, size(singleton_groups)
+         if (file%count(singleton_groups(g)) == 0) cycle
+         rewind (unit)
+         message = ''
+         call read_group(trim(singleton_groups(g)), scene, 1, ios, message, unit=unit)
+         if (ios /= 0) then
+            call report_read_error(file, trim(singleton_groups(g)), 1, message, status)
+            return
+         end if
+      end do
+   end subroutine read_singleton_groups
+
+   !> Read every occurrence of the repeated groups, in file order, each from the defaults.
+   subroutine read_repeated_groups(unit, file, scene, status)
+      integer, intent(in) :: unit
+      type(namelist_file_t), intent(in) :: file
+      type(scene_t), intent(inout) :: scene
+      type(status_t), intent(inout) :: status
+      type(scene_t) :: one
+      type(material_spec_t) :: default_material
+      type(body_spec_t) :: default_body
+      character(len=512) :: message
+      character(len=:), allocatable :: group
+      integer :: g, k, n, ios
+
+      allocate (scene%materials(file%count('material')), scene%bodies(file%count('body')))
+      allocate (one%materials(1), one%bodies(1))
+      do g = 1, size(repeated_groups)
+         group = trim(repeated_groups(g))
+         n = file%count(group)
+         rewind (unit)
+         k = 0
+         do
+            one%materials(1) = default_material
+            one%bodies(1) = default_body
+            message = ''
+            call read_group(group, one, 1, ios, message, unit=unit)
+            ! gfortran can also end a read that failed inside a group with iostat_end (`hydrostatic = 'yes'`).
+            if (ios == iostat_end .and. k >= n) exit
+            k = k + 1
+            if (ios /= 0) then
+               call report_read_error(file, group, k, message, status)
+               return
+            else if (k > n) then
+               exit
+            end if
+            select case (group)
+            case ('material')
+               scene%materials(k) = one%materials(1)
+            case ('body')
+               scene%bodies(k) = one%bodies(1)
+            end select
+         end do
+         if (k /= n) then
+            ! Only a group start the scan did not see as one (e.g. inside a string) can cause this.
+            call status%fail(file%path//': the namelist reader found '//int_text(k)//' groups &'//group//' but the file has '// &
+                             int_text(n)//'; is &'//group//' written inside a string or after a comment?')
+            return
+         end if
+      end do
+   end subroutine read_repeated_groups
+
+   !> The base file must give every required variable (and the parameters its material model needs).
+   subroutine check_required_variables(file, scene, status)
+      type(namelist_file_t), intent(in) :: file
+      type(scene_t), intent(in) :: scene
+      type(status_t), intent(inout) :: status
+      character(len=:), allocatable :: group, where
+      integer :: v, g, k
+
+      do g = 1, size(file%groups)
+         group = file%groups(g)%name
+         k = count_before(file, g) + 1
+         select case (group)
+         case ('material')
+            where = group_context(file%path, group, k, name_detail(scene%materials(k)%name))
+         case ('body')
+            where = group_context(file%path, group, k, material_detail(scene%bodies(k)%material))
+         case default
+            where = group_context(file%path, group, 0)
+         end select
+         do v = 1, size(variables)
+            if (variables(v)%group /= group .or. .not. variables(v)%required) cycle
+            if (.not. file%groups(g)%assigns(variables(v)%name)) then
+               call status%fail(where//': variable '//trim(variables(v)%name)//' is required')
+               return
+            end if
+         end do
+         if (group == 'material') then
+            associate (material => scene%materials(k))
+               if (material%model == model_newtonian_fluid .and. .not. file%groups(g)%assigns('bulk_modulus')) then
+                  call status%fail(where//": variable bulk_modulus is required for model '"//model_newtonian_fluid//"'")
+               else if (material%model == model_linear_elastic .and. &
+                        .not. file%groups(g)%assigns('youngs_modulus')) then
+                  call status%fail(where//": variable youngs_modulus is required for model '"//model_linear_elastic//"'")
+               end if
+               if (.not. status%ok) return
+            end associate
+         end if
+      end do
+   end subroutine check_required_variables
+
+   !> How many groups of the same name come before group `g`.
+   pure integer function count_before(file, g) result(n)
+      type(namelist_file_t), intent(in) :: file
+      integer, intent(in) :: g
+      integer :: i
+      n = 0
+      do i = 1, g - 1
+         if (file%groups(i)%name == file%groups(g)%name) n = n + 1
+      end do
+   end function count_before
+
+   pure function name_detail(name) result(detail)
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: detail
+      detail = ''
+      if (len_trim(name) > 0) detail = "name '"//trim(name)//"'"
+   end function name_detail
+
+   pure function material_detail(material) result(detail)
+      character(len=*), intent(in) :: material
+      character(len=:), allocatable :: detail
+      detail = ''
+      if (len_trim(material) > 0) detail = "material '"//trim(material)//"'"
+   end function material_detail
+
+   !> A group read failed: find the item responsible by reading the group's items one at a time, and
+   !> report it by name. gfortran's own message names the value rather than the variable for a value
+   !> of the wrong type (`cfl = 'abc'` gives "Cannot match namelist object name 'abc'").
+   subroutine report_read_error(file, group, occurrence, message, status)
+      type(namelist_file_t), intent(in) :: file
+      character(len=*), intent(in) :: group
+      integer, intent(in) :: occurrence
+      character(len=*), intent(in) :: message
+      type(status_t), intent(inout) :: status
+      type(scene_t) :: one
+      character(len=512) :: item_message
+      character(len=:), allocatable :: label, prefix
+      integer :: g, i, v, ios
+
+      label = ''
+      if (any(repeated_groups == group)) label = ' ('//ordinal(occurrence)//')'
+      g = file%find(group, occurrence)
+      if (g == 0) then
+         call status%fail(file%path//': group &'//group//label//': '//trim(message))
+         return
+      end if
+      allocate (one%materials(1), one%bodies(1))
+      associate (items => file%groups(g)%items)
+         do i = 1, size(items)
+            prefix = file%path//': line '//int_text(items(i)%line)//': group &'//group//label
+            if (len(items(i)%designator) == 0) then
+               call status%fail(prefix//": expected 'variable = value', got '"//items(i)%value//"'")
+               return
+            end if
+            item_message = ''
+            call read_group(group, one, 1, ios, item_message, text='&'//group//' '//items(i)%text()//' /')
+            if (ios == 0) cycle
+            v = find_variable(group, items(i)%name)
+            if (ios == value_too_long) then
+               call status%fail(prefix//': '//trim(item_message))
+            else if (v == 0 .or. item_message == 'Cannot match namelist object name '//items(i)%name) then
+               call status%fail(prefix//': unknown variable '//items(i)%name//unknown_hint(group, items(i)%name))
+            else if (scan(items(i)%designator, '(%') > 0) then
+               call status%fail(prefix//': variable '//items(i)%designator//' = '//items(i)%value//' cannot be read: '// &
+                                trim(item_message))
+            else
+               call status%fail(prefix//': variable '//items(i)%name//' must be '//expected_value(variables(v)%kind)// &
+                                ', got '//items(i)%value)
+            end if
+            return
+         end do
+      end associate
+      ! Every item reads on its own: report the reader's message for the whole group.
+      call status%fail(file%path//': line '//int_text(file%groups(g)%first_line)//': group &'//group//label//': '// &
+                       trim(message))
+   end subroutine report_read_error
+
+   !> Position of variable `name` of `group` in `variables`; 0 if the group has no such variable.
+   pure integer function find_variable(group, name) result(found)
+      character(len=*), intent(in) :: group, name
+      integer :: v
+      found = 0
+      do v = 1, size(variables)
+         if (variables(v)%group == group .and. variables(v)%name == name) then
+            found = v
+            return
+         end if
+      end do
+   end function find_variable
+
+   !> " (dim belongs to group &grid)" or " (variables of &run: end_time, cfl, ...)".
+   pure function unknown_hint(group, name) result(hint)
+      character(len=*), intent(in) :: group, name
+      character(len=:), allocatable :: hint
+      integer :: v
+      do v = 1, size(variables)
+         if (variables(v)%name == name .and. variables(v)%group /= group) then
+            hint = ' ('//name//' belongs to group &'//trim(variables(v)%group)//')'
+            return
+         end if
+      end do
+      hint = ''
+      do v = 1, size(variables)
+         if (variables(v)%group /= group) cycle
+         if (len(hint) > 0) hint = hint//', '
+         hint = hint//trim(variables(v)%name)
+      end do
+      hint = ' (variables of &'//group//': '//hint//')'
+   end function unknown_hint
+
+   pure function expected_value(kind) result(text)
+      character(len=*), intent(in) :: kind
+      character(len=:), allocatable :: text
+      select case (kind)
+      case ('real')
+         text = 'a real number'
+      case ('real3')
+         text = 'up to 3 real numbers'
+      case ('integer')
+         text = 'an integer (no decimal point or exponent)'
+      case ('logical')
+         text = 'a logical (.true. or .false.)'
+      case default
+         text = 'a quoted string'
+      end select
+   end function expected_value
+
+   !> Read group `group` into `scene` (into entry `k` of a repeated group) from `unit`, or from the
+   !> internal file `text` when it is present.
+   subroutine read_group(group, scene, k, ios, message, unit, text)
+      character(len=*), intent(in) :: group
+      type(scene_t), intent(inout) :: scene
+      integer, intent(in) :: k
+      integer, intent(out) :: ios
+      character(len=*), intent(inout) :: message
+      integer, intent(in), optional :: unit
+      character(len=*), intent(in), optional :: text
+      select case (group)
+      case ('run')
+         call read_run_group(scene%run, ios, message, unit, text)
+      case ('grid')
+         call read_grid_group(scene%grid, ios, message, unit, text)
+      case ('box_walls')
+         call read_box_walls_group(scene%grid, ios, message, unit, text)
+      case ('gravity')
+         call read_gravity_group(scene%gravity, ios, message, unit, text)
+      case ('material')
+         call read_material_group(scene%materials(k), ios, message, unit, text)
+      case ('body')
+         call read_body_group(scene%bodies(k), ios, message, unit, text)
+      case default
+         ios = value_too_long
+         message = 'no namelist group &'//group
+      end select
+   end subroutine read_group
+
+   !> ios = value_too_long and a message if string `value` does not fit in `limit` characters.
+   subroutine check_length(variable, value, limit, ios, message)
+      character(len=*), intent(in) :: variable, value
+      integer, intent(in) :: limit
+      integer, intent(inout) :: ios
+      character(len=*), intent(inout) :: message
+      if (ios /= 0 .or. len_trim(value) <= limit) return
+      ios = value_too_long
+      message = 'variable '//variable//' must be at most '//int_text(limit)//' characters long, got '// &
+                int_text(len_trim(value))
+   end subroutine check_length
+
+   subroutine read_run_group(control, ios, message, unit, text)
+      type(run_control_t), intent(inout) :: control
+      integer, intent(out) :: ios
+      character(len=*), intent(inout) :: message
+      integer, intent(in), optional :: unit
+      character(len=*), intent(in), optional :: text
+      real(rp) :: end_time, cfl, dt, output_interval, flip_fraction, theta, progress_interval, floor_size
+      character(len=text_len) :: output_dir, update_scheme
+      logical :: overwrite
+      integer(i8) :: max_steps
+      namelist /run/ end_time, cfl, dt, output_interval, output_dir, overwrite, update_scheme, flip_fraction, &
+         theta, max_steps, progress_interval, floor_size
+
+      end_time = control%end_time
+      cfl = control%cfl
+      dt = control%fixed_dt
+      output_interval = control%output_interval
+      output_dir = control%output_dir
+      overwrite = control%overwrite
+      update_scheme = control%update_scheme
+      flip_fraction = control%flip_fraction
+      theta = control%theta
+      max_steps = control%max_steps
+      progress_interval = control%progress_interval
+      floor_size = control%floor_size
+      if (present(text)) then
+         read (text, nml=run, iostat=ios, iomsg=message)
+      else
+         read (unit, nml=run, iostat=ios, iomsg=message)
+      end if
+      call check_length('output_dir', output_dir, len(control%output_dir), ios, message)
+      call check_length('update_scheme', update_scheme, len(control%update_scheme), ios, message)
+      if (ios /= 0) return
+      control%end_time = end_time
+      control%cfl = cfl
+      control%fixed_dt = dt
+      control%output_interval = output_interval
+      control%output_dir = output_dir(1:len(control%output_dir))
+      control%overwrite = overwrite
+      control%update_scheme = upper_case(adjustl(update_scheme))
+      control%flip_fraction = flip_fraction
+      control%theta = theta
+      control%max_steps = max_steps
+      control%progress_interval = progress_interval
+      control%floor_size = floor_size
+   end subroutine read_run_group
+
+   subroutine read_grid_group(spec, ios, message, unit, text)
+      type(grid_spec_t), intent(inout) :: spec
+      integer, intent(out) :: ios
+      character(len=*), intent(inout) :: message
+      integer, intent(in), optional :: unit
+      character(len=*), intent(in), optional :: text
+      integer :: dim
+      real(rp) :: cell_size, origin(3), extent(3)
+      namelist /grid/ dim, cell_size, origin, extent
+
+      dim = spec%dim
+      cell_size = spec%cell_size
+      origin = spec%origin
+      extent = spec%extent
+      if (present(text)) then
+         read (text, nml=grid, iostat=ios, iomsg=message)
+      else
+         read (unit, nml=grid, iostat=ios, iomsg=message)
+      end if
+      if (ios /= 0) return
+      spec%dim = dim
+      spec%cell_size = cell_size
+      spec%origin = origin
+      spec%extent = extent
+   end subroutine read_grid_group
+
+   subroutine read_box_walls_group(spec, ios, message, unit, text)
+      type(grid_spec_t), intent(inout) :: spec
+      integer, intent(out) :: ios
+      character(len=*), intent(inout) :: message
+      integer, intent(in), optional :: unit
+      character(len=*), intent(in), optional :: text
+      character(len=text_len) :: x_min, x_max, y_min, y_max, z_min, z_max
+      namelist /box_walls/ x_min, x_max, y_min, y_max, z_min, z_max
+
+      x_min = spec%wall(1, 1)
+      x_max = spec%wall(2, 1)
+      y_min = spec%wall(1, 2)
+      y_max = spec%wall(2, 2)
+      z_min = spec%wall(1, 3)
+      z_max = spec%wall(2, 3)
+      if (present(text)) then
+         read (text, nml=box_walls, iostat=ios, iomsg=message)
+      else
+         read (unit, nml=box_walls, iostat=ios, iomsg=message)
+      end if
+      call check_length('x_min', x_min, len(spec%wall), ios, message)
+      call check_length('x_max', x_max, len(spec%wall), ios, message)
+      call check_length('y_min', y_min, len(spec%wall), ios, message)
+      call check_length('y_max', y_max, len(spec%wall), ios, message)
+      call check_length('z_min', z_min, len(spec%wall), ios, message)
+      call check_length('z_max', z_max, len(spec%wall), ios, message)
+      if (ios /= 0) return
+      spec%wall(1, 1) = lower_case(adjustl(x_min))
+      spec%wall(2, 1) = lower_case(adjustl(x_max))
+      spec%wall(1, 2) = lower_case(adjustl(y_min))
+      spec%wall(2, 2) = lower_case(adjustl(y_max))
+      spec%wall(1, 3) = lower_case(adjustl(z_min))
+      spec%wall(2, 3) = lower_case(adjustl(z_max))
+   end subroutine read_box_walls_group
+
+   subroutine read_gravity_group(vector, ios, message, unit, text)
+      real(rp), intent(inout) :: vector(3)
+      integer, intent(out) :: ios
+      character(len=*), intent(inout) :: message
+      integer, intent(in), optional :: unit
+      character(len=*), intent(in), optional :: text
+      real(rp) :: acceleration(3)
+      namelist /gravity/ acceleration
+
+      acceleration = vector
+      if (present(text)) then
+         read (text, nml=gravity, iostat=ios, iomsg=message)
+      else
+         read (unit, nml=gravity, iostat=ios, iomsg=message)
+      end if
+      if (ios /= 0) return
+      vector = acceleration
+   end subroutine read_gravity_group
+
+   subroutine read_material_group(spec, ios, message, unit, text)
+      type(material_spec_t), intent(inout) :: spec
+      integer, intent(out) :: ios
+      character(len=*), intent(inout) :: message
+      integer, intent(in), optional :: unit
+      character(len=*), intent(in), optional :: text
+      character(len=text_len) :: name, model, stabilization
+      real(rp) :: density, bulk_modulus, viscosity, youngs_modulus, poisson_ratio
+      namelist /material/ name, model, density, bulk_modulus, viscosity, youngs_modulus, poisson_ratio, stabilization
+
+      name = spec%name
+      model = spec%model
+      density = spec%density
+      bulk_modulus = spec%bulk_modulus
+      viscosity = spec%viscosity
+      youngs_modulus = spec%youngs_modulus
+      poisson_ratio = spec%poisson_ratio
+      stabilization = spec%stabilization
+      if (present(text)) then
+         read (text, nml=material, iostat=ios, iomsg=message)
+      else
+         read (unit, nml=material, iostat=ios, iomsg=message)
+      end if
+      call check_length('name', name, len(spec%name), ios, message)
+      call check_length('model', model, len(spec%model), ios, message)
+      call check_length('stabilization', stabilization, len(spec%stabilization), ios, message)
+      if (ios /= 0) return
+      spec%name = name(1:len(spec%name))
+      spec%model = lower_case(adjustl(model))
+      spec%density = density
+      spec%bulk_modulus = bulk_modulus
+      spec%viscosity = viscosity
+      spec%youngs_modulus = youngs_modulus
+      spec%poisson_ratio = poisson_ratio
+      spec%stabilization = canonical_keyword(adjustl(stabilization), stabilization_keywords)
+   end subroutine read_material_group
+
+   subroutine read_body_group(spec, ios, message, unit, text)
+      type(body_spec_t), intent(inout) :: spec
+      integer, intent(out) :: ios
+      character(len=*), intent(inout) :: message
+      integer, intent(in), optional :: unit
+      character(len=*), intent(in), optional :: text
+      character(len=text_len) :: material
+      real(rp) :: lower(3), upper(3), velocity(3), free_surface_level
+      integer :: particles_per_cell
+      logical :: hydrostatic
+      namelist /body/ material, lower, upper, particles_per_cell, velocity, hydrostatic, free_surface_level
+
+      material = spec%material
+      lower = spec%lower
+      upper = spec%upper
+      particles_per_cell = spec%particles_per_cell
+      velocity = spec%velocity
+      hydrostatic = spec%hydrostatic
+      free_surface_level = spec%free_surface_level
+      if (present(text)) then
+         read (text, nml=body, iostat=ios, iomsg=message)
+      else
+         read (unit, nml=body, iostat=ios, iomsg=message)
+      end if
+      call check_length('material', material, len(spec%material), ios, message)
+      if (ios /= 0) return
+      spec%material = material(1:len(spec%material))
+      spec%lower = lower
+      spec%upper = upper
+      spec%particles_per_cell = particles_per_cell
+      spec%velocity = velocity
+      spec%hydrostatic = hydrostatic
+      spec%free_surface_level = free_surface_level
+   end subroutine read_body_group
+end module scene_reader

@@ -1,0 +1,45 @@
+!> A CSV file written row by row and flushed after each row, so a killed run leaves whole rows only.
+module csv_writer
+   use error_status, only: status_t
+   implicit none
+   private
+
+   type, public :: csv_writer_t
+      integer :: unit = -1
+   contains
+      procedure :: open => csv_open
+      procedure :: write_row => csv_write_row
+      procedure :: close => csv_close
+   end type csv_writer_t
+
+contains
+
+   subroutine csv_open(self, path, header, status)
+      class(csv_writer_t), intent(inout) :: self
+      character(len=*), intent(in) :: path, header
+      type(status_t), intent(inout) :: status
+      integer :: ios
+      character(len=256) :: msg
+      open (newunit=self%unit, file=path, status='replace', action='write', iostat=ios, iomsg=msg)
+      if (ios /= 0) then
+         call status%fail('cannot open '//trim(path)//': '//trim(msg))
+         self%unit = -1
+         return
+      end if
+      call self%write_row(header)
+   end subroutine csv_open
+
+   subroutine csv_write_row(self, line)
+      class(csv_writer_t), intent(inout) :: self
+      character(len=*), intent(in) :: line
+      if (self%unit < 0) return
+      write (self%unit, '(a)') line
+      flush (self%unit)
+   end subroutine csv_write_row
+
+   subroutine csv_close(self)
+      class(csv_writer_t), intent(inout) :: self
+      if (self%unit >= 0) close (self%unit)
+      self%unit = -1
+   end subroutine csv_close
+end module csv_writer

@@ -1,0 +1,60 @@
+!> Weakly compressible Newtonian fluid in rate form (algorithms.md section 5.1):
+!>   p^{n+1} = p^n - K tr(d~) dt,   sigma = -p^{n+1} I + 2 mu dev(d~),   rho^{n+1} = rho^n / det(I + dt d~).
+!> The pressure is integrated, not recomputed from J, so that a smoothed stress persists [D].
+module newtonian_fluid
+   use kinds, only: rp
+   use material_model, only: material_model_t, volume_ratio_increment
+   implicit none
+   private
+
+   type, extends(material_model_t), public :: newtonian_fluid_t
+      real(rp) :: bulk_modulus = 0.0_rp   !< K [Pa]
+      real(rp) :: viscosity = 0.0_rp      !< mu [Pa s]
+   contains
+      procedure :: update_stress => fluid_update_stress
+      procedure :: wave_speed => fluid_wave_speed
+   end type newtonian_fluid_t
+
+   public :: fluid_point_update
+
+contains
+
+   subroutine fluid_update_stress(self, dim, dt, strain_rate, spin, density, sbar)
+      class(newtonian_fluid_t), intent(in) :: self
+      integer, intent(in) :: dim
+      real(rp), intent(in) :: dt
+      real(rp), intent(in) :: strain_rate(:, :), spin(:, :)
+      real(rp), intent(inout) :: density(:), sbar(:, :)
+      integer :: p
+      ! The spin is not used: the pressure is isotropic and the viscous stress is recomputed from d~
+      ! every step, so neither has a Jaumann rotation term.
+      if (size(spin) < 0) return
+      do p = 1, size(density)
+         call fluid_point_update(self%bulk_modulus, self%viscosity, dim, dt, strain_rate(:, p), density(p), sbar(:, p))
+      end do
+   end subroutine fluid_update_stress
+
+   !> One particle: update density and mass-specific stress sbar = sigma / rho.
+   pure subroutine fluid_point_update(bulk_modulus, viscosity, dim, dt, d, density, sbar)
+      real(rp), intent(in) :: bulk_modulus, viscosity, dt, d(:)
+      integer, intent(in) :: dim
+      real(rp), intent(inout) :: density, sbar(:)
+      real(rp) :: pressure, trace_d, new_density, two_mu
+      integer :: n_normal
+      pressure = -density * (sbar(1) + sbar(2) + sbar(3)) / 3.0_rp
+      trace_d = d(1) + d(2) + d(3)
+      pressure = pressure - bulk_modulus * trace_d * dt
+      new_density = density / volume_ratio_increment(dim, dt, d)
+      two_mu = 2.0_rp * viscosity
+      n_normal = 3
+      sbar(1:n_normal) = (-pressure + two_mu * (d(1:n_normal) - trace_d / 3.0_rp)) / new_density
+      sbar(n_normal + 1:) = two_mu * d(n_normal + 1:) / new_density
+      density = new_density
+   end subroutine fluid_point_update
+
+   pure real(rp) function fluid_wave_speed(self, density)
+      class(newtonian_fluid_t), intent(in) :: self
+      real(rp), intent(in) :: density
+      fluid_wave_speed = sqrt(self%bulk_modulus / density)
+   end function fluid_wave_speed
+end module newtonian_fluid

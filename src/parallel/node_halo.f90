@@ -1,0 +1,128 @@
+!> Ghost-node summation: nodes on the boundary between two ranks' cell boxes receive particle
+!> contributions on both ranks; afterwards each rank must hold the full sum.
+!>
+!> One axis at a time, each rank packs its two boundary node planes (whole local extent of the other
+!> axes) into contiguous buffers, exchanges them with both face neighbours and adds what it receives.
+!> Axis by axis, edge and corner nodes pick up the sums of all 2**dim ranks that share them.
+module node_halo
+   use kinds, only: rp
+   use mpi_f08, only: MPI_Request, MPI_Isend, MPI_Irecv, MPI_Waitall, MPI_DOUBLE_PRECISION, &
+                      MPI_STATUSES_IGNORE, MPI_PROC_NULL
+   use domain_decomposition, only: domain_t
+   use background_grid, only: grid_t
+   implicit none
+   private
+
+   public :: sum_shared_nodes
+
+contains
+
+   !> field(:, node) := sum over all ranks sharing the node. Collective over domain%comm.
+   subroutine sum_shared_nodes(domain, grid, field)
+      type(domain_t), intent(in) :: domain
+      type(grid_t), intent(in) :: grid
+      real(rp), intent(inout) :: field(:, :)
+      real(rp), allocatable :: send_buf(:, :), recv_buf(:, :)
+      type(MPI_Request) :: requests(4)
+      integer :: k, side, nv, plane_size, count, plane_index(2)
+      integer, parameter :: tag = 101
+
+      nv = size(field, 1)
+      do k = 1, domain%dim
+         if (all(domain%neighbour(:, k) == MPI_PROC_NULL)) cycle
+         plane_size = grid%node_count / grid%n_nodes(k)
+         count = nv * plane_size
+         allocate (send_buf(count, 2), recv_buf(count, 2))
+         plane_index = [1, grid%n_nodes(k)]
+         do side = 1, 2
+            call pack_plane(grid, k, plane_index(side), field, send_buf(:, side))
+         end do
+         ! side 1 = lower neighbour, side 2 = upper neighbour
+         do side = 1, 2
+            call MPI_Irecv(recv_buf(:, side), count, MPI_DOUBLE_PRECISION, domain%neighbour(side, k), tag, &
+                           domain%comm, requests(side))
+         end do
+         do side = 1, 2
+            call MPI_Isend(send_buf(:, side), count, MPI_DOUBLE_PRECISION, domain%neighbour(side, k), tag, &
+                           domain%comm, requests(2 + side))
+         end do
+         call MPI_Waitall(4, requests, MPI_STATUSES_IGNORE)
+         do side = 1, 2
+            if (domain%neighbour(side, k) /= MPI_PROC_NULL) &
+               call add_plane(grid, k, plane_index(side), recv_buf(:, side), field)
+         end do
+         deallocate (send_buf, recv_buf)
+      end do
+   end subroutine sum_shared_nodes
+
+   !> Copy the node plane with local index `layer` along axis k into a contiguous buffer.
+   subroutine pack_plane(grid, k, layer, field, buf)
+      type(grid_t), intent(in) :: grid
+      integer, intent(in) :: k, layer
+      real(rp), intent(in) :: field(:, :)
+      real(rp), intent(out) :: buf(:)
+      integer :: i, j, l, nv, pos, node
+      nv = size(field, 1)
+      pos = 0
+      do l = 1, plane_extent(grid, k, 2)
+         do j = 1, plane_extent(grid, k, 1)
+            node = plane_node(grid, k, layer, j, l)
+            do i = 1, nv
+               buf(pos + i) = field(i, node)
+            end do
+            pos = pos + nv
+         end do
+      end do
+   end subroutine pack_plane
+
+   !> Add a received plane to the node plane with local index `layer` along axis k.
+   subroutine add_plane(grid, k, layer, buf, field)
+      type(grid_t), intent(in) :: grid
+      integer, intent(in) :: k, layer
+      real(rp), intent(in) :: buf(:)
+      real(rp), intent(inout) :: field(:, :)
+      integer :: i, j, l, nv, pos, node
+      nv = size(field, 1)
+      pos = 0
+      do l = 1, plane_extent(grid, k, 2)
+         do j = 1, plane_extent(grid, k, 1)
+            node = plane_node(grid, k, layer, j, l)
+            do i = 1, nv
+               field(i, node) = field(i, node) + buf(pos + i)
+            end do
+            pos = pos + nv
+         end do
+      end do
+   end subroutine add_plane
+
+   !> Node count of the plane normal to k along its first (which = 1) or second (which = 2) in-plane axis.
+   pure integer function plane_extent(grid, k, which)
+      type(grid_t), intent(in) :: grid
+      integer, intent(in) :: k, which
+      integer :: axes(2)
+      axes = in_plane_axes(k)
+      plane_extent = grid%n_nodes(axes(which))
+   end function plane_extent
+
+   !> Local flat node index of in-plane position (j, l) (1-based) in layer `layer` along axis k.
+   pure integer function plane_node(grid, k, layer, j, l)
+      type(grid_t), intent(in) :: grid
+      integer, intent(in) :: k, layer, j, l
+      integer :: local(3), axes(2)
+      axes = in_plane_axes(k)
+      local(k) = layer
+      local(axes(1)) = j
+      local(axes(2)) = l
+      plane_node = local(1) + grid%n_nodes(1) * ((local(2) - 1) + grid%n_nodes(2) * (local(3) - 1))
+   end function plane_node
+
+   pure function in_plane_axes(k) result(axes)
+      integer, intent(in) :: k
+      integer :: axes(2)
+      select case (k)
+      case (1); axes = [2, 3]
+      case (2); axes = [1, 3]
+      case default; axes = [1, 2]
+      end select
+   end function in_plane_axes
+end module node_halo

@@ -1,0 +1,76 @@
+!> Hands particles that left a rank's cell box to the neighbour that owns them, one axis at a time
+!> (a diagonal move takes two hops). Particles that leave the whole grid are removed and counted.
+module particle_migration
+   use kinds, only: rp
+   use mpi_f08, only: MPI_Sendrecv, MPI_INTEGER, MPI_DOUBLE_PRECISION, MPI_STATUS_IGNORE, MPI_PROC_NULL
+   use domain_decomposition, only: domain_t
+   use background_grid, only: grid_t
+   use particle_set, only: particle_set_t
+   implicit none
+   private
+
+   public :: migrate_particles
+
+contains
+
+   !> Move every particle to the rank owning its cell. `lost` counts particles that left the grid,
+   !> `arrived` the particles received from other ranks. Collective over domain%comm.
+   subroutine migrate_particles(domain, grid, particles, lost, arrived)
+      type(domain_t), intent(in) :: domain
+      type(grid_t), intent(in) :: grid
+      type(particle_set_t), intent(inout) :: particles
+      integer, intent(inout) :: lost
+      integer, intent(out) :: arrived
+      real(rp), allocatable :: outgoing(:, :, :), incoming(:, :)
+      integer :: k, p, kept, side, c, n_out(2), n_in(2), width, other
+      integer, parameter :: tag_count = 201, tag_data = 202
+
+      width = particles%record_size()
+      arrived = 0
+      do k = 1, domain%dim
+         allocate (outgoing(width, max(1, particles%count), 2))
+         n_out = 0
+         kept = 0
+         do p = 1, particles%count
+            c = grid%cell_along(particles%x(k, p), k)
+            side = 0
+            if (c < domain%cell_lo(k)) side = 1
+            if (c > domain%cell_hi(k)) side = 2
+            if (side == 0) then
+               kept = kept + 1
+               if (kept /= p) call particles%copy_particle(p, kept)
+            else if (domain%neighbour(side, k) == MPI_PROC_NULL) then
+               lost = lost + 1
+            else
+               n_out(side) = n_out(side) + 1
+               call particles%pack_record(p, outgoing(:, n_out(side), side))
+            end if
+         end do
+         particles%count = kept
+
+         do side = 1, 2
+            other = 3 - side
+            ! send to the neighbour on `side`, receive from the one on the other side
+            call MPI_Sendrecv(n_out(side), 1, MPI_INTEGER, domain%neighbour(side, k), tag_count, &
+                              n_in(other), 1, MPI_INTEGER, domain%neighbour(other, k), tag_count, &
+                              domain%comm, MPI_STATUS_IGNORE)
+            if (domain%neighbour(other, k) == MPI_PROC_NULL) n_in(other) = 0
+         end do
+         do side = 1, 2
+            other = 3 - side
+            allocate (incoming(width, max(1, n_in(other))))
+            call MPI_Sendrecv(outgoing(:, 1:n_out(side), side), width * n_out(side), MPI_DOUBLE_PRECISION, &
+                              domain%neighbour(side, k), tag_data, &
+                              incoming, width * n_in(other), MPI_DOUBLE_PRECISION, &
+                              domain%neighbour(other, k), tag_data, domain%comm, MPI_STATUS_IGNORE)
+            call particles%reserve(particles%count + n_in(other))
+            arrived = arrived + n_in(other)
+            do p = 1, n_in(other)
+               call particles%append_record(incoming(:, p))
+            end do
+            deallocate (incoming)
+         end do
+         deallocate (outgoing)
+      end do
+   end subroutine migrate_particles
+end module particle_migration

@@ -1,0 +1,77 @@
+!> Fills the declared bodies with particles on a regular lattice, each rank creating only the
+!> particles inside its own cells.
+!>
+!> A body spans lower..upper; along axis k it holds n_k = nint((upper_k - lower_k) / (h / ppc))
+!> particles at spacing (upper_k - lower_k) / n_k, centred in their lattice cells, so the body's mass
+!> is exactly rho0 times its volume. Particle ids are body offset + lattice index: they do not depend
+!> on the number of ranks.
+module particle_seeding
+   use kinds, only: rp, i8
+   use scene_description, only: scene_t, body_spec_t
+   use tensor_layout, only: n_components
+   use background_grid, only: grid_t
+   use domain_decomposition, only: domain_t
+   use particle_set, only: particle_set_t
+   implicit none
+   private
+
+   public :: lattice_counts, seed_bodies
+
+contains
+
+   !> Particles of a body along each axis (1 on unused axes).
+   pure function lattice_counts(body, dim, cell_size) result(n)
+      type(body_spec_t), intent(in) :: body
+      integer, intent(in) :: dim
+      real(rp), intent(in) :: cell_size
+      integer :: n(3)
+      n = 1
+      n(1:dim) = nint((body%upper(1:dim) - body%lower(1:dim)) / (cell_size / body%particles_per_cell))
+   end function lattice_counts
+
+   !> Create this rank's particles of every body of the scene.
+   subroutine seed_bodies(scene, grid, domain, particles)
+      type(scene_t), intent(in) :: scene
+      type(grid_t), intent(in) :: grid
+      type(domain_t), intent(in) :: domain
+      type(particle_set_t), intent(inout) :: particles
+      integer :: b, dim, n(3), i, j, l, c(3)
+      integer(i8) :: id_offset
+      real(rp) :: spacing(3), x(3), particle_volume, up(3), g_norm, pressure, density
+      real(rp), allocatable :: sbar(:)
+
+      dim = grid%dim
+      allocate (sbar(n_components(dim)))
+      g_norm = norm2(scene%gravity(1:dim))
+      up = 0.0_rp
+      if (g_norm > 0.0_rp) up(1:dim) = -scene%gravity(1:dim) / g_norm
+      id_offset = 0
+      do b = 1, size(scene%bodies)
+         associate (body => scene%bodies(b))
+            n = lattice_counts(body, dim, grid%h)
+            spacing = 1.0_rp
+            spacing(1:dim) = (body%upper(1:dim) - body%lower(1:dim)) / n(1:dim)
+            particle_volume = product(spacing(1:dim))
+            density = scene%materials(body%material_index)%density
+            do l = 0, n(3) - 1
+               do j = 0, n(2) - 1
+                  do i = 0, n(1) - 1
+                     x = body%lower + ([i, j, l] + 0.5_rp) * spacing
+                     c = grid%cell_of_position(x(1:dim))
+                     if (.not. domain%owns_cell(c(1:dim))) cycle
+                     sbar = 0.0_rp
+                     if (body%hydrostatic) then
+                        ! p = rho0 |g| (depth below the free surface); sbar = -p / rho0 on the normal components
+                        pressure = density * g_norm * max(0.0_rp, body%free_surface_level - dot_product(up(1:dim), x(1:dim)))
+                        sbar(1:3) = -pressure / density
+                     end if
+                     call particles%add(x(1:dim), body%velocity(1:dim), density * particle_volume, density, sbar, &
+                                        body%material_index, id_offset + i + int(n(1), i8) * (j + int(n(2), i8) * l))
+                  end do
+               end do
+            end do
+            id_offset = id_offset + product(int(n, i8))
+         end associate
+      end do
+   end subroutine seed_bodies
+end module particle_seeding

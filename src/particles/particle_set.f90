@@ -1,0 +1,201 @@
+!> The material points a rank owns, as a structure of arrays (style.md, lesson 5).
+!>
+!> Persistent state: position, velocity, mass, density, mass-specific stress sbar = sigma / rho
+!> (algorithms.md section 1), material, global id. Scratch per step: the (filtered) rate of deformation
+!> and the spin. After `sort_by_material_and_cell` the particles of material m occupy the contiguous
+!> range material_first(m):material_last(m), ordered by cell, so material updates and cell sums run
+!> over contiguous slices.
+module particle_set
+   use kinds, only: rp, i8
+   use tensor_layout, only: n_components, n_spin
+   implicit none
+   private
+
+   type, public :: particle_set_t
+      integer :: dim = 2, n_sigma = 4, n_spin = 1, n_materials = 1
+      integer :: count = 0                          !< particles held
+      real(rp), allocatable :: x(:, :)              !< position (dim, p), grid frame [m]
+      real(rp), allocatable :: v(:, :)              !< velocity (dim, p) [m/s]
+      real(rp), allocatable :: mass(:)              !< mass [kg] (per unit thickness in 2-D)
+      real(rp), allocatable :: density(:)           !< current density [kg/m^3]
+      real(rp), allocatable :: sbar(:, :)           !< mass-specific stress (n_sigma, p) [Pa m^3/kg]
+      integer, allocatable :: material(:)           !< material index
+      integer(i8), allocatable :: id(:)             !< globally unique id
+      integer, allocatable :: cell(:)               !< local cell index at x^n (set by the sort)
+      real(rp), allocatable :: strain_rate(:, :)    !< d_p, replaced by d~_p when filtered (n_sigma, p)
+      real(rp), allocatable :: spin(:, :)           !< w_p components (n_spin, p)
+      integer, allocatable :: material_first(:), material_last(:)
+   contains
+      procedure :: init => particles_init
+      procedure :: reserve => particles_reserve
+      procedure :: record_size => particles_record_size
+      procedure :: pack_record => particles_pack_record
+      procedure :: append_record => particles_append_record
+      procedure :: add => particles_add
+      procedure :: copy_particle => particles_copy_particle
+      procedure :: volume => particles_volume
+   end type particle_set_t
+
+contains
+
+   subroutine particles_init(self, dim, n_materials, capacity)
+      class(particle_set_t), intent(inout) :: self
+      integer, intent(in) :: dim, n_materials, capacity
+      self%dim = dim
+      self%n_sigma = n_components(dim)
+      self%n_spin = n_spin(dim)
+      self%n_materials = n_materials
+      self%count = 0
+      if (allocated(self%x)) call free_arrays(self)
+      call allocate_arrays(self, max(capacity, 16))
+      allocate (self%material_first(n_materials), self%material_last(n_materials))
+      self%material_first = 1
+      self%material_last = 0
+   end subroutine particles_init
+
+   subroutine allocate_arrays(self, capacity)
+      type(particle_set_t), intent(inout) :: self
+      integer, intent(in) :: capacity
+      allocate (self%x(self%dim, capacity), self%v(self%dim, capacity), self%mass(capacity), &
+                self%density(capacity), self%sbar(self%n_sigma, capacity), self%material(capacity), &
+                self%id(capacity), self%cell(capacity), self%strain_rate(self%n_sigma, capacity), &
+                self%spin(self%n_spin, capacity))
+   end subroutine allocate_arrays
+
+   subroutine free_arrays(self)
+      type(particle_set_t), intent(inout) :: self
+      deallocate (self%x, self%v, self%mass, self%density, self%sbar, self%material, self%id, self%cell, &
+                  self%strain_rate, self%spin)
+      if (allocated(self%material_first)) deallocate (self%material_first, self%material_last)
+   end subroutine free_arrays
+
+   !> Make room for at least `capacity` particles, keeping the first `count`.
+   subroutine particles_reserve(self, capacity)
+      class(particle_set_t), intent(inout) :: self
+      integer, intent(in) :: capacity
+      integer :: n
+      n = self%count
+      if (capacity <= size(self%mass)) return
+      call grow_real2(self%x, capacity, n)
+      call grow_real2(self%v, capacity, n)
+      call grow_real1(self%mass, capacity, n)
+      call grow_real1(self%density, capacity, n)
+      call grow_real2(self%sbar, capacity, n)
+      call grow_int1(self%material, capacity, n)
+      call grow_i8(self%id, capacity, n)
+      call grow_int1(self%cell, capacity, n)
+      call grow_real2(self%strain_rate, capacity, n)
+      call grow_real2(self%spin, capacity, n)
+   end subroutine particles_reserve
+
+   subroutine grow_real2(a, capacity, n)
+      real(rp), allocatable, intent(inout) :: a(:, :)
+      integer, intent(in) :: capacity, n
+      real(rp), allocatable :: b(:, :)
+      allocate (b(size(a, 1), capacity))
+      b(:, 1:n) = a(:, 1:n)
+      call move_alloc(b, a)
+   end subroutine grow_real2
+
+   subroutine grow_real1(a, capacity, n)
+      real(rp), allocatable, intent(inout) :: a(:)
+      integer, intent(in) :: capacity, n
+      real(rp), allocatable :: b(:)
+      allocate (b(capacity))
+      b(1:n) = a(1:n)
+      call move_alloc(b, a)
+   end subroutine grow_real1
+
+   subroutine grow_int1(a, capacity, n)
+      integer, allocatable, intent(inout) :: a(:)
+      integer, intent(in) :: capacity, n
+      integer, allocatable :: b(:)
+      allocate (b(capacity))
+      b(1:n) = a(1:n)
+      call move_alloc(b, a)
+   end subroutine grow_int1
+
+   subroutine grow_i8(a, capacity, n)
+      integer(i8), allocatable, intent(inout) :: a(:)
+      integer, intent(in) :: capacity, n
+      integer(i8), allocatable :: b(:)
+      allocate (b(capacity))
+      b(1:n) = a(1:n)
+      call move_alloc(b, a)
+   end subroutine grow_i8
+
+   !> Reals needed to carry one particle's persistent state between ranks.
+   pure integer function particles_record_size(self)
+      class(particle_set_t), intent(in) :: self
+      particles_record_size = 2 * self%dim + 2 + self%n_sigma + 2
+   end function particles_record_size
+
+   !> Persistent state of particle p as reals (ids travel bit-for-bit through transfer()).
+   pure subroutine particles_pack_record(self, p, record)
+      class(particle_set_t), intent(in) :: self
+      integer, intent(in) :: p
+      real(rp), intent(out) :: record(:)
+      integer :: d, s
+      d = self%dim
+      s = self%n_sigma
+      record(1:d) = self%x(:, p)
+      record(d + 1:2 * d) = self%v(:, p)
+      record(2 * d + 1) = self%mass(p)
+      record(2 * d + 2) = self%density(p)
+      record(2 * d + 3:2 * d + 2 + s) = self%sbar(:, p)
+      record(2 * d + 3 + s) = real(self%material(p), rp)
+      record(2 * d + 4 + s) = transfer(self%id(p), 1.0_rp)
+   end subroutine particles_pack_record
+
+   !> Append one particle from a record made by pack_record.
+   subroutine particles_append_record(self, record)
+      class(particle_set_t), intent(inout) :: self
+      real(rp), intent(in) :: record(:)
+      integer :: d, s
+      d = self%dim
+      s = self%n_sigma
+      call self%add(record(1:d), record(d + 1:2 * d), record(2 * d + 1), record(2 * d + 2), &
+                    record(2 * d + 3:2 * d + 2 + s), nint(record(2 * d + 3 + s)), transfer(record(2 * d + 4 + s), 1_i8))
+   end subroutine particles_append_record
+
+   !> Append one particle given its persistent state.
+   subroutine particles_add(self, x, v, mass, density, sbar, material, id)
+      class(particle_set_t), intent(inout) :: self
+      real(rp), intent(in) :: x(:), v(:), mass, density, sbar(:)
+      integer, intent(in) :: material
+      integer(i8), intent(in) :: id
+      integer :: p
+      if (self%count == size(self%mass)) call self%reserve(max(16, self%count + self%count / 2))
+      p = self%count + 1
+      self%count = p
+      self%x(:, p) = x
+      self%v(:, p) = v
+      self%mass(p) = mass
+      self%density(p) = density
+      self%sbar(:, p) = sbar
+      self%material(p) = material
+      self%id(p) = id
+      self%cell(p) = 0
+   end subroutine particles_add
+
+   !> Copy the persistent state of particle `from` into slot `to` (compaction after removal).
+   pure subroutine particles_copy_particle(self, from, to)
+      class(particle_set_t), intent(inout) :: self
+      integer, intent(in) :: from, to
+      self%x(:, to) = self%x(:, from)
+      self%v(:, to) = self%v(:, from)
+      self%mass(to) = self%mass(from)
+      self%density(to) = self%density(from)
+      self%sbar(:, to) = self%sbar(:, from)
+      self%material(to) = self%material(from)
+      self%id(to) = self%id(from)
+      self%cell(to) = self%cell(from)
+   end subroutine particles_copy_particle
+
+   !> Current volume m / rho of particle p (area per unit thickness in 2-D).
+   pure real(rp) function particles_volume(self, p)
+      class(particle_set_t), intent(in) :: self
+      integer, intent(in) :: p
+      particles_volume = self%mass(p) / self%density(p)
+   end function particles_volume
+end module particle_set

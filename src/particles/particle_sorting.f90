@@ -1,0 +1,130 @@
+!> Keeps particles ordered by (material, cell): contiguous per-material slices for the constitutive
+!> and stabilization loops, and cell order inside each slice so that grid access is local.
+!> A counting sort: O(particles + materials * local cells).
+module particle_sorting
+   use kinds, only: rp, i8
+   use background_grid, only: grid_t
+   use particle_set, only: particle_set_t
+   implicit none
+   private
+
+   public :: sort_by_material_and_cell, update_cells
+
+contains
+
+   !> Set particles%cell to the local cell at the current position, keeping the order. Enough between
+   !> sorts while no particle has arrived: removals keep the (material, cell) grouping of the rest.
+   subroutine update_cells(grid, particles)
+      type(grid_t), intent(in) :: grid
+      type(particle_set_t), intent(inout) :: particles
+      integer :: p
+      do p = 1, particles%count
+         particles%cell(p) = grid%local_cell(grid%cell_of_position(particles%x(:, p)))
+      end do
+      call set_material_ranges(particles)
+   end subroutine update_cells
+
+   !> Sort and set particles%cell (local cell at the current position) and the material ranges.
+   !> Every particle must lie in an owned cell (call after migration).
+   subroutine sort_by_material_and_cell(grid, particles)
+      type(grid_t), intent(in) :: grid
+      type(particle_set_t), intent(inout) :: particles
+      integer, allocatable :: key(:), start(:), dest(:)
+      integer :: p, n, n_keys, m
+
+      n = particles%count
+      n_keys = particles%n_materials * grid%cell_count
+      allocate (key(n), dest(n), start(n_keys + 1))
+      start = 0
+      do p = 1, n
+         particles%cell(p) = grid%local_cell(grid%cell_of_position(particles%x(:, p)))
+         key(p) = (particles%material(p) - 1) * grid%cell_count + particles%cell(p)
+         start(key(p) + 1) = start(key(p) + 1) + 1
+      end do
+      ! start(k) = number of particles with a smaller key, then the running slot of key k
+      start(1) = 0
+      do m = 2, n_keys + 1
+         start(m) = start(m) + start(m - 1)
+      end do
+      do p = 1, n
+         start(key(p)) = start(key(p)) + 1
+         dest(p) = start(key(p))
+      end do
+
+      call permute_real2(particles%x, dest, n)
+      call permute_real2(particles%v, dest, n)
+      call permute_real1(particles%mass, dest, n)
+      call permute_real1(particles%density, dest, n)
+      call permute_real2(particles%sbar, dest, n)
+      call permute_int1(particles%material, dest, n)
+      call permute_int1(particles%cell, dest, n)
+      call permute_i8(particles%id, dest, n)
+
+      call set_material_ranges(particles)
+   end subroutine sort_by_material_and_cell
+
+   !> material_first(m):material_last(m) = the slice of material m (empty slice: first = 1, last = 0).
+   subroutine set_material_ranges(particles)
+      type(particle_set_t), intent(inout) :: particles
+      integer :: p, m
+      particles%material_first = 1
+      particles%material_last = 0
+      do p = particles%count, 1, -1
+         particles%material_first(particles%material(p)) = p
+      end do
+      do p = 1, particles%count
+         particles%material_last(particles%material(p)) = p
+      end do
+      do m = 1, particles%n_materials
+         if (particles%material_last(m) == 0) particles%material_first(m) = 1
+      end do
+   end subroutine set_material_ranges
+
+   subroutine permute_real2(a, dest, n)
+      real(rp), intent(inout) :: a(:, :)
+      integer, intent(in) :: dest(:), n
+      real(rp), allocatable :: b(:, :)
+      integer :: p
+      allocate (b(size(a, 1), n))
+      do p = 1, n
+         b(:, dest(p)) = a(:, p)
+      end do
+      a(:, 1:n) = b
+   end subroutine permute_real2
+
+   subroutine permute_real1(a, dest, n)
+      real(rp), intent(inout) :: a(:)
+      integer, intent(in) :: dest(:), n
+      real(rp), allocatable :: b(:)
+      integer :: p
+      allocate (b(n))
+      do p = 1, n
+         b(dest(p)) = a(p)
+      end do
+      a(1:n) = b
+   end subroutine permute_real1
+
+   subroutine permute_int1(a, dest, n)
+      integer, intent(inout) :: a(:)
+      integer, intent(in) :: dest(:), n
+      integer, allocatable :: b(:)
+      integer :: p
+      allocate (b(n))
+      do p = 1, n
+         b(dest(p)) = a(p)
+      end do
+      a(1:n) = b
+   end subroutine permute_int1
+
+   subroutine permute_i8(a, dest, n)
+      integer(i8), intent(inout) :: a(:)
+      integer, intent(in) :: dest(:), n
+      integer(i8), allocatable :: b(:)
+      integer :: p
+      allocate (b(n))
+      do p = 1, n
+         b(dest(p)) = a(p)
+      end do
+      a(1:n) = b
+   end subroutine permute_i8
+end module particle_sorting

@@ -1,0 +1,88 @@
+!> Particle-grid transfers of the explicit MPM step (algorithms.md section 1.2, steps 1, 3 and 7).
+!>
+!> The kernels are written once, in grid_transfer_kernels.inc, and instantiated for 2-D and 3-D with the
+!> dimension as a compile-time constant, so that the loops over axes and corners unroll. The public
+!> routines pick the instance from grid%dim.
+module grid_transfer
+   use kinds, only: rp
+   use background_grid, only: grid_t, row_mass
+   use particle_set, only: particle_set_t
+   implicit none
+   private
+
+   public :: particles_to_grid, momentum_to_grid, grid_to_particles
+
+contains
+
+   !> Step 1: m_i = sum N m_p, P_i = sum N m_p v_p,
+   !> f_i = -sum m_p sbar_p . grad N_i + sum N m_p g   ([Y17] eq. 3; sbar is the filtered stress).
+   subroutine particles_to_grid(grid, particles, gravity)
+      type(grid_t), intent(inout) :: grid
+      type(particle_set_t), intent(in) :: particles
+      real(rp), intent(in) :: gravity(:)
+      grid%accumulated = 0.0_rp
+      if (grid%dim == 2) then
+         call particles_to_grid_2d(grid, particles, gravity)
+      else
+         call particles_to_grid_3d(grid, particles, gravity)
+      end if
+   end subroutine particles_to_grid
+
+   !> MUSL re-map: momentum(:, i) = sum N m_p v_p with the updated particle velocities.
+   subroutine momentum_to_grid(grid, particles, momentum)
+      type(grid_t), intent(in) :: grid
+      type(particle_set_t), intent(in) :: particles
+      real(rp), intent(out) :: momentum(:, :)
+      momentum = 0.0_rp
+      if (grid%dim == 2) then
+         call momentum_to_grid_2d(grid, particles, momentum)
+      else
+         call momentum_to_grid_3d(grid, particles, momentum)
+      end if
+   end subroutine momentum_to_grid
+
+   !> Steps 3 and 7 at x^n. With v_i^{n+theta} = v_i^{n+1} - (1 - theta) dv_i:
+   !>   L_p = sum v_i^{n+theta} (x) grad N_i  -> strain_rate = sym(L), spin = skew(L)   (if compute_strain)
+   !>   v_p := alpha (v_p + sum N dv_i) + (1 - alpha) sum N v_i^{n+1}                  (if update_velocity)
+   !>   x_p := x_p + dt sum N v_i^{n+theta}                                             (if update_position)
+   !> `strain_velocity`, when present, replaces v^{n+theta} in L (MUSL: the re-mapped velocities).
+   subroutine grid_to_particles(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
+                                update_position, strain_velocity)
+      type(grid_t), intent(in) :: grid
+      type(particle_set_t), intent(inout) :: particles
+      real(rp), intent(in) :: dt, flip_fraction, theta
+      logical, intent(in) :: update_velocity, compute_strain, update_position
+      real(rp), intent(in), optional :: strain_velocity(:, :)
+      if (grid%dim == 2) then
+         call grid_to_particles_2d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
+                                   update_position, strain_velocity)
+      else
+         call grid_to_particles_3d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
+                                   update_position, strain_velocity)
+      end if
+   end subroutine grid_to_particles
+
+#define KERNEL_DIM 2
+#define SHAPE shape_2d
+#define LOCATE locate_2d
+#define P2G particles_to_grid_2d
+#define M2G momentum_to_grid_2d
+#define G2P grid_to_particles_2d
+#include "../grid/multilinear_shape.inc"
+#include "grid_transfer_kernels.inc"
+#undef KERNEL_DIM
+#undef SHAPE
+#undef LOCATE
+#undef P2G
+#undef M2G
+#undef G2P
+
+#define KERNEL_DIM 3
+#define SHAPE shape_3d
+#define LOCATE locate_3d
+#define P2G particles_to_grid_3d
+#define M2G momentum_to_grid_3d
+#define G2P grid_to_particles_3d
+#include "../grid/multilinear_shape.inc"
+#include "grid_transfer_kernels.inc"
+end module grid_transfer

@@ -1,0 +1,256 @@
+!> The explicit MPM solver on a rank's part of the domain decomposition (algorithms.md section 1.2).
+!>
+!> One step t_n -> t_n+1:
+!>   1. particles -> grid (mass, momentum, internal and external force), ghost-node sums
+!>   2. nodal update v^{n+1} = v^n + dt f / m, wall constraints (eq. 14), dv and v^{n+theta}
+!>   3. stabilization schemes bin their cells at x^n
+!>   4. grid -> particles: L_p, FLIP/PIC velocity, positions (MUSL: re-map before L)
+!>   5. filter part A (d -> d~), constitutive update per material, filter part B (sbar -> sbar~)
+!>   6. wall safeguard, migration to owning ranks, sort by (material, cell), next dt.
+module mpm_solver
+   use kinds, only: rp, i8
+   use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_MIN
+   use error_status, only: status_t
+   use scene_description, only: scene_t, run_control_t
+   use domain_decomposition, only: domain_t
+   use background_grid, only: grid_t, row_mass
+   use node_halo, only: sum_shared_nodes
+   use particle_set, only: particle_set_t
+   use particle_seeding, only: seed_bodies
+   use particle_sorting, only: sort_by_material_and_cell, update_cells
+   use particle_migration, only: migrate_particles
+   use material_model, only: material_slot_t
+   use material_factory, only: build_materials
+   use newtonian_fluid, only: newtonian_fluid_t
+   use stabilizer, only: stabilizer_slot_t
+   use stabilizer_factory, only: build_stabilizers
+   use boundary_walls, only: wall_t, build_box_walls, apply_wall_constraints, keep_particles_inside
+   use grid_transfer, only: particles_to_grid, momentum_to_grid, grid_to_particles
+   use run_diagnostics, only: diagnostics_t, compute_diagnostics
+   use status_broadcast, only: agree_on_status
+   implicit none
+   private
+
+   !> Steps between full re-sorts of the particles when none arrived from another rank.
+   integer, parameter :: sort_interval = 20
+
+   type, public :: solver_t
+      type(run_control_t) :: run
+      real(rp) :: gravity(3) = 0.0_rp
+      type(domain_t) :: domain
+      type(grid_t) :: grid
+      type(particle_set_t) :: particles
+      type(material_slot_t), allocatable :: materials(:)
+      type(stabilizer_slot_t), allocatable :: schemes(:)
+      type(wall_t), allocatable :: walls(:)
+      real(rp) :: time = 0.0_rp, dt = 0.0_rp
+      integer(i8) :: step = 0
+      integer :: lost_particles = 0             !< local count of particles that left the grid
+      integer :: wall_corrections = 0           !< local count of safeguard corrections
+      real(rp) :: mass_tolerance = 0.0_rp       !< nodes lighter than this carry no velocity
+      logical :: musl = .false.
+      real(rp), allocatable :: remapped_momentum(:, :)
+   contains
+      procedure :: init => solver_init
+      procedure :: advance => solver_advance
+      procedure :: stable_time_step => solver_stable_time_step
+      procedure :: diagnostics => solver_diagnostics
+      procedure :: free => solver_free
+   end type solver_t
+
+contains
+
+   !> Decompose, build the grid, materials, schemes and walls, seed the particles. Collective.
+   subroutine solver_init(self, scene, comm, status)
+      class(solver_t), intent(inout) :: self
+      type(scene_t), intent(in) :: scene
+      type(MPI_Comm), intent(in) :: comm
+      type(status_t), intent(inout) :: status
+      real(rp) :: min_mass
+
+      self%run = scene%run
+      self%gravity = scene%gravity
+      self%musl = scene%run%update_scheme == 'MUSL'
+      call self%domain%init(comm, scene%grid%dim, scene%grid%ncells, status)
+      if (.not. status%ok) return
+      call self%grid%init(self%domain, scene%grid%origin, scene%grid%cell_size)
+      call build_materials(scene%materials, self%materials, status)
+      if (status%ok) call build_stabilizers(scene%materials, self%schemes, status)
+      call agree_on_status(status, self%domain%comm)
+      if (.not. status%ok) return
+      call build_box_walls(scene%grid, self%grid, self%walls)
+
+      call self%particles%init(scene%grid%dim, size(scene%materials), 1024)
+      call seed_bodies(scene, self%grid, self%domain, self%particles)
+      call sort_by_material_and_cell(self%grid, self%particles)
+      if (self%musl) allocate (self%remapped_momentum(self%grid%dim, self%grid%node_count))
+
+      ! a node is "empty" below a millionth of a millionth of the lightest particle
+      min_mass = huge(1.0_rp)
+      if (self%particles%count > 0) min_mass = minval(self%particles%mass(1:self%particles%count))
+      call MPI_Allreduce(MPI_IN_PLACE, min_mass, 1, MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
+      self%mass_tolerance = 1.0e-12_rp * min_mass
+      self%time = 0.0_rp
+      self%step = 0
+      self%dt = self%stable_time_step()
+   end subroutine solver_init
+
+   !> One explicit step of length self%dt; afterwards self%dt holds the next stable step.
+   subroutine solver_advance(self)
+      class(solver_t), intent(inout) :: self
+      integer :: m, first, last, arrived
+      real(rp) :: dt
+
+      dt = self%dt
+      call particles_to_grid(self%grid, self%particles, self%gravity)
+      call sum_shared_nodes(self%domain, self%grid, self%grid%accumulated)
+      call update_nodes(self, dt)
+
+      do m = 1, size(self%schemes)
+         if (allocated(self%schemes(m)%scheme)) &
+            call self%schemes(m)%scheme%prepare(self%domain, self%grid, self%particles, dt)
+      end do
+
+      associate (run => self%run)
+         if (self%musl) then
+            call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
+                                   update_velocity=.true., compute_strain=.false., update_position=.false.)
+            call remap_velocities(self)
+            call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
+                                   update_velocity=.false., compute_strain=.true., update_position=.true., &
+                                   strain_velocity=self%remapped_momentum)
+         else
+            call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
+                                   update_velocity=.true., compute_strain=.true., update_position=.true.)
+         end if
+      end associate
+
+      do m = 1, size(self%schemes)
+         if (allocated(self%schemes(m)%scheme)) &
+            call self%schemes(m)%scheme%filter_strain_rate(self%domain, self%grid, self%particles, dt)
+      end do
+      do m = 1, size(self%materials)
+         first = self%particles%material_first(m)
+         last = self%particles%material_last(m)
+         if (last < first) cycle
+         call self%materials(m)%model%update_stress(self%grid%dim, dt, self%particles%strain_rate(:, first:last), &
+                                                   self%particles%spin(:, first:last), &
+                                                   self%particles%density(first:last), self%particles%sbar(:, first:last))
+      end do
+      do m = 1, size(self%schemes)
+         if (allocated(self%schemes(m)%scheme)) &
+            call self%schemes(m)%scheme%filter_stress(self%domain, self%grid, self%particles, dt)
+      end do
+
+      call keep_particles_inside(self%walls, self%particles, self%wall_corrections)
+      call migrate_particles(self%domain, self%grid, self%particles, self%lost_particles, arrived)
+      ! arrivals are appended at the end: re-sort so materials stay contiguous; otherwise re-sort now and
+      ! then for memory locality and only refresh the cells in between
+      if (arrived > 0 .or. mod(self%step + 1, int(sort_interval, i8)) == 0) then
+         call sort_by_material_and_cell(self%grid, self%particles)
+      else
+         call update_cells(self%grid, self%particles)
+      end if
+
+      self%time = self%time + dt
+      self%step = self%step + 1
+      self%dt = self%stable_time_step()
+   end subroutine solver_advance
+
+   !> Step 2: v^n = P/m, v^{n+1} = v^n + dt f/m, walls, dv = v^{n+1} - v^n (contains the wall correction).
+   subroutine update_nodes(self, dt)
+      type(solver_t), intent(inout) :: self
+      real(rp), intent(in) :: dt
+      integer :: i, dim, mom, frc
+      real(rp) :: m
+      dim = self%grid%dim
+      mom = self%grid%row_momentum
+      frc = self%grid%row_force
+      associate (acc => self%grid%accumulated, v => self%grid%velocity, dv => self%grid%velocity_increment)
+         do i = 1, self%grid%node_count
+            m = acc(row_mass, i)
+            if (m > self%mass_tolerance) then
+               dv(:, i) = acc(mom:mom + dim - 1, i) / m                 ! v^n, for now
+               v(:, i) = dv(:, i) + dt * acc(frc:frc + dim - 1, i) / m  ! v^{n+1} before walls
+            else
+               dv(:, i) = 0.0_rp
+               v(:, i) = 0.0_rp
+            end if
+         end do
+         call apply_wall_constraints(self%walls, dim, v)
+         dv = v - dv
+      end associate
+   end subroutine update_nodes
+
+   !> MUSL: nodal velocities from the momentum of the updated particle velocities, with walls.
+   subroutine remap_velocities(self)
+      type(solver_t), intent(inout) :: self
+      integer :: i
+      real(rp) :: m
+      call momentum_to_grid(self%grid, self%particles, self%remapped_momentum)
+      call sum_shared_nodes(self%domain, self%grid, self%remapped_momentum)
+      do i = 1, self%grid%node_count
+         m = self%grid%accumulated(row_mass, i)
+         if (m > self%mass_tolerance) then
+            self%remapped_momentum(:, i) = self%remapped_momentum(:, i) / m
+         else
+            self%remapped_momentum(:, i) = 0.0_rp
+         end if
+      end do
+      call apply_wall_constraints(self%walls, self%grid%dim, self%remapped_momentum)
+   end subroutine remap_velocities
+
+   !> dt = CFL h / (sqrt(dim) max_p (c_p + |v_p|)), limited by the viscous step CFL rho h^2 / (2 dim mu)
+   !> (algorithms.md section 5.4), or the fixed dt of &run. Collective (global minimum).
+   real(rp) function solver_stable_time_step(self) result(dt)
+      class(solver_t), intent(inout) :: self
+      real(rp) :: speed, h
+      integer :: m, first, last
+      h = self%grid%h
+      if (self%run%fixed_dt > 0.0_rp) then
+         dt = self%run%fixed_dt
+         return
+      end if
+      speed = 0.0_rp
+      dt = huge(1.0_rp)
+      do m = 1, size(self%materials)
+         first = self%particles%material_first(m)
+         last = self%particles%material_last(m)
+         if (last >= first) speed = max(speed, self%materials(m)%model%max_signal_speed( &
+                                         self%particles%density(first:last), self%particles%v(:, first:last)))
+      end do
+      if (speed > 0.0_rp) dt = self%run%cfl * h / (sqrt(real(self%grid%dim, rp)) * speed)
+      dt = min(dt, viscous_time_step(self))
+      call MPI_Allreduce(MPI_IN_PLACE, dt, 1, MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
+   end function solver_stable_time_step
+
+   !> CFL rho0 h^2 / (2 dim mu) over the viscous fluids present.
+   real(rp) function viscous_time_step(self) result(dt)
+      type(solver_t), intent(in) :: self
+      integer :: m
+      dt = huge(1.0_rp)
+      do m = 1, size(self%materials)
+         select type (model => self%materials(m)%model)
+         type is (newtonian_fluid_t)
+            if (model%viscosity > 0.0_rp) dt = min(dt, self%run%cfl * model%reference_density * self%grid%h**2 / &
+                                                       (2.0_rp * self%grid%dim * model%viscosity))
+         end select
+      end do
+   end function viscous_time_step
+
+   !> Global diagnostics at the current time. Collective.
+   function solver_diagnostics(self) result(diag)
+      class(solver_t), intent(in) :: self
+      type(diagnostics_t) :: diag
+      diag%time = self%time
+      diag%step = self%step
+      diag%dt = self%dt
+      call compute_diagnostics(self%domain%comm, self%particles, self%materials, self%run%floor_size, &
+                               int(self%lost_particles, i8), int(self%wall_corrections, i8), diag)
+   end function solver_diagnostics
+
+   subroutine solver_free(self)
+      class(solver_t), intent(inout) :: self
+      call self%domain%free()
+   end subroutine solver_free
+end module mpm_solver

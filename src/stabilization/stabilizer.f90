@@ -1,0 +1,39 @@
+!> Interface of the anti-locking and smoothing schemes applied per material (algorithms.md sections 2, 3).
+!>
+!> A scheme acts on the contiguous slice of one material's particles at three points of a step:
+!>   prepare            before grid-to-particle, while the particles are still at x^n (cell binning);
+!>   filter_strain_rate between the kinematics and the stress update (filter part A, d -> d~);
+!>   filter_stress      after the stress update (filter part B and smoothing, sbar -> sbar~).
+!> Standard MPM ('none') has no scheme object at all, so it costs nothing.
+module stabilizer
+   use kinds, only: rp
+   use domain_decomposition, only: domain_t
+   use background_grid, only: grid_t
+   use particle_set, only: particle_set_t
+   implicit none
+   private
+
+   type, abstract, public :: stabilizer_t
+      integer :: material = 0     !< material index whose particles this scheme filters
+   contains
+      procedure(stage_interface), deferred :: prepare
+      procedure(stage_interface), deferred :: filter_strain_rate
+      procedure(stage_interface), deferred :: filter_stress
+   end type stabilizer_t
+
+   abstract interface
+      subroutine stage_interface(self, domain, grid, particles, dt)
+         import :: stabilizer_t, domain_t, grid_t, particle_set_t, rp
+         class(stabilizer_t), intent(inout) :: self
+         type(domain_t), intent(in) :: domain
+         type(grid_t), intent(in) :: grid
+         type(particle_set_t), intent(inout) :: particles
+         real(rp), intent(in) :: dt
+      end subroutine stage_interface
+   end interface
+
+   !> A material's scheme; unallocated means standard MPM.
+   type, public :: stabilizer_slot_t
+      class(stabilizer_t), allocatable :: scheme
+   end type stabilizer_slot_t
+end module stabilizer
