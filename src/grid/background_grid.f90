@@ -36,6 +36,7 @@ module background_grid
       procedure :: base_node_of_cell => grid_base_node_of_cell
       procedure :: cell_of_position => grid_cell_of_position
       procedure :: cell_along => grid_cell_along
+      procedure :: owned_local_cell => grid_owned_local_cell
    end type grid_t
 
 contains
@@ -136,4 +137,26 @@ contains
       c = floor(s)
       if (c == self%global_cells(k) .and. s <= real(self%global_cells(k), rp) * (1 + epsilon(s))) c = c - 1
    end function grid_cell_along
+
+   !> Local index of the owned cell holding x, or 0 if x lies outside the owned cells.
+   !> (cell_along followed by local_cell, in one pass: this runs for every particle every step.)
+   pure integer function grid_owned_local_cell(self, x) result(cell)
+      class(grid_t), intent(in) :: self
+      real(rp), intent(in) :: x(:)
+      integer :: k, c, stride
+      real(rp) :: s
+      cell = 1
+      stride = 1
+      do k = 1, self%dim
+         s = (x(k) - self%origin(k)) * self%inv_h
+         c = floor(s)
+         if (c == self%global_cells(k) .and. s <= real(self%global_cells(k), rp) * (1 + epsilon(s))) c = c - 1
+         if (c < self%cell_lo(k) .or. c > self%cell_hi(k)) then
+            cell = 0
+            return
+         end if
+         cell = cell + (c - self%cell_lo(k)) * stride
+         stride = stride * self%n_cells(k)
+      end do
+   end function grid_owned_local_cell
 end module background_grid

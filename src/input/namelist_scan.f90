@@ -211,7 +211,7 @@ contains
                else if (c == '!') then
                   exit
                else if (is_blank(c)) then
-                  if (inside) call append(body, ' ', l)
+                  if (inside) call append_blank(body, l)
                else if (c == '&' .or. c == '$') then
                   name_end = name_length(text(i + 1:))
                   name = lower_case(text(i + 1:i + name_end))
@@ -257,7 +257,7 @@ contains
                end if
                i = i + 1
             end do
-            if (inside .and. quote == ' ') call append(body, ' ', l)
+            if (inside .and. quote == ' ') call append_blank(body, l)
          end associate
       end do
       if (inside) then
@@ -325,6 +325,16 @@ contains
       body%text(body%length:body%length) = c
       body%line_of(body%length) = line
    end subroutine append
+
+   !> A separator blank; runs of blanks, comments and line breaks between values become one blank.
+   subroutine append_blank(body, line)
+      type(group_text_t), intent(inout) :: body
+      integer, intent(in) :: line
+      if (body%length > 0) then
+         if (body%text(body%length:body%length) == ' ') return
+      end if
+      call append(body, ' ', line)
+   end subroutine append_blank
 
    subroutine open_group(file, body, name, line)
       type(namelist_file_t), intent(inout) :: file

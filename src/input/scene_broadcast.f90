@@ -1,27 +1,16 @@
-!> Copy a scene, and the status of reading it, from the rank that read the file to every rank.
+!> Copy a scene from the rank that read the file to every rank.
 module scene_broadcast
-   use kinds, only: message_len
-   use mpi_f08, only: MPI_Comm, MPI_Bcast, MPI_CHARACTER, MPI_INTEGER, MPI_LOGICAL
-   use error_status, only: status_t
+   use mpi_f08, only: MPI_Comm, MPI_Bcast, MPI_CHARACTER, MPI_INTEGER
    use scene_description, only: scene_t
    implicit none
    private
 
-   public :: broadcast_scene, broadcast_scene_status
+   public :: broadcast_scene
 
    !> Mould of `transfer` to and from bytes.
    character(len=1), parameter :: byte_mold(0) = [character(len=1) ::]
 
 contains
-
-   !> Copy `root`'s ok flag and message to every rank. Collective over `comm`.
-   subroutine broadcast_scene_status(status, comm, root)
-      type(status_t), intent(inout) :: status
-      type(MPI_Comm), intent(in) :: comm
-      integer, intent(in) :: root
-      call MPI_Bcast(status%ok, 1, MPI_LOGICAL, root, comm)
-      call MPI_Bcast(status%message, message_len, MPI_CHARACTER, root, comm)
-   end subroutine broadcast_scene_status
 
    !> Copy `root`'s scene to every rank: array sizes first, then the contents. Collective over `comm`.
    !> Every component of the scene types has a fixed size, so each part travels as its bytes

@@ -14,7 +14,8 @@ module scene_reader
                                 model_newtonian_fluid, model_linear_elastic
    use namelist_scan, only: namelist_file_t, namelist_group_t, scan_namelist_file
    use scene_validation, only: validate_scene, resolve_scene, stabilization_keywords
-   use scene_broadcast, only: broadcast_scene, broadcast_scene_status
+   use scene_broadcast, only: broadcast_scene
+   use status_broadcast, only: broadcast_status
    use input_text, only: lower_case, upper_case, int_text, ordinal, group_context, canonical_keyword
    implicit none
    private
@@ -106,7 +107,7 @@ contains
          if (status%ok) call validate_scene(scene, trim(path), status)
          if (status%ok) call resolve_scene(scene)
       end if
-      call broadcast_scene_status(status, comm, root)
+      call broadcast_status(status, comm, root)
       if (status%ok) then
          call broadcast_scene(scene, comm, root)
       else

@@ -5,7 +5,8 @@ module csv_writer
    private
 
    type, public :: csv_writer_t
-      integer :: unit = -1
+      integer :: unit = 0
+      logical :: is_open = .false.    !< newunit= numbers are negative: track the state separately
    contains
       procedure :: open => csv_open
       procedure :: write_row => csv_write_row
@@ -23,23 +24,23 @@ contains
       open (newunit=self%unit, file=path, status='replace', action='write', iostat=ios, iomsg=msg)
       if (ios /= 0) then
          call status%fail('cannot open '//trim(path)//': '//trim(msg))
-         self%unit = -1
          return
       end if
+      self%is_open = .true.
       call self%write_row(header)
    end subroutine csv_open
 
    subroutine csv_write_row(self, line)
       class(csv_writer_t), intent(inout) :: self
       character(len=*), intent(in) :: line
-      if (self%unit < 0) return
+      if (.not. self%is_open) return
       write (self%unit, '(a)') line
       flush (self%unit)
    end subroutine csv_write_row
 
    subroutine csv_close(self)
       class(csv_writer_t), intent(inout) :: self
-      if (self%unit >= 0) close (self%unit)
-      self%unit = -1
+      if (self%is_open) close (self%unit)
+      self%is_open = .false.
    end subroutine csv_close
 end module csv_writer

@@ -58,7 +58,7 @@ contains
       left = self%elapsed() * (1.0_rp - fraction) / max(fraction, 1.0e-12_rp)
       write (error_unit, '(a,es11.4,a,f6.2,a,i0,a,es9.2,a,es9.2,a,a)') 't = ', time, ' s (', 100 * fraction, &
          ' %)  step ', step, '  ', steps_per_s, ' steps/s  ', psteps_per_s, ' particle-steps/s  ETA ', &
-         clock_text(left)
+         trim(clock_text(left))
       flush (error_unit)
       self%last_count = now
       self%last_step = step

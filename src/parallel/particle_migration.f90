@@ -13,8 +13,9 @@ module particle_migration
 
 contains
 
-   !> Move every particle to the rank owning its cell. `lost` counts particles that left the grid,
-   !> `arrived` the particles received from other ranks. Collective over domain%comm.
+   !> Move every particle to the rank owning its cell and set particles%cell (local cell) of every
+   !> particle kept or received. `lost` counts particles that left the grid, `arrived` the particles
+   !> received from other ranks. Collective over domain%comm.
    subroutine migrate_particles(domain, grid, particles, lost, arrived)
       type(domain_t), intent(in) :: domain
       type(grid_t), intent(in) :: grid
@@ -22,31 +23,44 @@ contains
       integer, intent(inout) :: lost
       integer, intent(out) :: arrived
       real(rp), allocatable :: outgoing(:, :, :), incoming(:, :)
-      integer :: k, p, kept, side, c, n_out(2), n_in(2), width, other
+      integer :: k, p, kept, side, c, n_out(2), n_in(2), width, other, n_outside, first_new
       integer, parameter :: tag_count = 201, tag_data = 202
+
+      ! cells of all particles; cell = 0 marks a particle outside this rank's box
+      n_outside = 0
+      do p = 1, particles%count
+         call locate_particle(p)
+      end do
 
       width = particles%record_size()
       arrived = 0
       do k = 1, domain%dim
-         allocate (outgoing(width, max(1, particles%count), 2))
          n_out = 0
-         kept = 0
-         do p = 1, particles%count
-            c = grid%cell_along(particles%x(k, p), k)
-            side = 0
-            if (c < domain%cell_lo(k)) side = 1
-            if (c > domain%cell_hi(k)) side = 2
-            if (side == 0) then
-               kept = kept + 1
-               if (kept /= p) call particles%copy_particle(p, kept)
-            else if (domain%neighbour(side, k) == MPI_PROC_NULL) then
-               lost = lost + 1
-            else
-               n_out(side) = n_out(side) + 1
-               call particles%pack_record(p, outgoing(:, n_out(side), side))
-            end if
-         end do
-         particles%count = kept
+         allocate (outgoing(width, max(1, n_outside), 2))
+         if (n_outside > 0) then
+            kept = 0
+            do p = 1, particles%count
+               side = 0
+               if (particles%cell(p) == 0) then
+                  c = grid%cell_along(particles%x(k, p), k)
+                  if (c < domain%cell_lo(k)) side = 1
+                  if (c > domain%cell_hi(k)) side = 2
+               end if
+               if (side == 0) then
+                  kept = kept + 1
+                  if (kept /= p) call particles%copy_particle(p, kept)
+               else
+                  n_outside = n_outside - 1
+                  if (domain%neighbour(side, k) == MPI_PROC_NULL) then
+                     lost = lost + 1
+                  else
+                     n_out(side) = n_out(side) + 1
+                     call particles%pack_record(p, outgoing(:, n_out(side), side))
+                  end if
+               end if
+            end do
+            particles%count = kept
+         end if
 
          do side = 1, 2
             other = 3 - side
@@ -64,13 +78,26 @@ contains
                               incoming, width * n_in(other), MPI_DOUBLE_PRECISION, &
                               domain%neighbour(other, k), tag_data, domain%comm, MPI_STATUS_IGNORE)
             call particles%reserve(particles%count + n_in(other))
-            arrived = arrived + n_in(other)
+            first_new = particles%count + 1
             do p = 1, n_in(other)
                call particles%append_record(incoming(:, p))
             end do
+            ! a diagonal move may still be outside along a later axis
+            do p = first_new, particles%count
+               call locate_particle(p)
+            end do
+            arrived = arrived + n_in(other)
             deallocate (incoming)
          end do
          deallocate (outgoing)
       end do
+
+   contains
+
+      subroutine locate_particle(q)
+         integer, intent(in) :: q
+         particles%cell(q) = grid%owned_local_cell(particles%x(:, q))
+         if (particles%cell(q) == 0) n_outside = n_outside + 1
+      end subroutine locate_particle
    end subroutine migrate_particles
 end module particle_migration

@@ -8,12 +8,12 @@ module particle_sorting
    implicit none
    private
 
-   public :: sort_by_material_and_cell, update_cells
+   public :: sort_by_material_and_cell, update_cells, set_material_ranges
 
 contains
 
-   !> Set particles%cell to the local cell at the current position, keeping the order. Enough between
-   !> sorts while no particle has arrived: removals keep the (material, cell) grouping of the rest.
+   !> Set particles%cell to the local cell at the current position (every particle in an owned cell),
+   !> keeping the order, and the material ranges.
    subroutine update_cells(grid, particles)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
@@ -24,8 +24,8 @@ contains
       call set_material_ranges(particles)
    end subroutine update_cells
 
-   !> Sort and set particles%cell (local cell at the current position) and the material ranges.
-   !> Every particle must lie in an owned cell (call after migration).
+   !> Sort by (material, particles%cell) and set the material ranges. particles%cell must be current
+   !> (update_cells, or migrate_particles which sets it).
    subroutine sort_by_material_and_cell(grid, particles)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
@@ -37,7 +37,6 @@ contains
       allocate (key(n), dest(n), start(n_keys + 1))
       start = 0
       do p = 1, n
-         particles%cell(p) = grid%local_cell(grid%cell_of_position(particles%x(:, p)))
          key(p) = (particles%material(p) - 1) * grid%cell_count + particles%cell(p)
          start(key(p) + 1) = start(key(p) + 1) + 1
       end do

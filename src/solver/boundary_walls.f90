@@ -16,6 +16,7 @@ module boundary_walls
       real(rp) :: normal(3) = 0.0_rp       !< unit normal pointing into the domain
       real(rp) :: point(3) = 0.0_rp        !< a point on the wall (grid frame)
       logical :: no_slip = .false.
+      integer :: axis = 0                  !< k if the normal is +-e_k (box walls), else 0
       integer, allocatable :: nodes(:)     !< local nodes this rank constrains
    end type wall_t
 
@@ -43,6 +44,7 @@ contains
             plane = merge(0, grid%global_cells(k), side == 1)
             wall%point(k) = grid%origin(k) + plane * grid%h
             wall%no_slip = condition == wall_no_slip
+            wall%axis = k
             if (condition /= wall_slip .and. condition /= wall_no_slip) cycle
             if (plane < grid%node_lo(k) .or. plane > grid%node_hi(k)) then
                allocate (wall%nodes(0))
@@ -101,6 +103,10 @@ contains
       real(rp) :: distance, vn
       d = particles%dim
       do w = 1, size(walls)
+         if (walls(w)%axis > 0) then
+            call keep_inside_axis_wall(walls(w), particles, corrections)
+            cycle
+         end if
          associate (n => walls(w)%normal(1:d), x0 => walls(w)%point(1:d))
             do p = 1, particles%count
                distance = dot_product(particles%x(:, p) - x0, n)
@@ -114,4 +120,23 @@ contains
          end associate
       end do
    end subroutine keep_particles_inside
+
+   !> The safeguard for a wall normal to axis k: the same operation without the dot products.
+   subroutine keep_inside_axis_wall(wall, particles, corrections)
+      type(wall_t), intent(in) :: wall
+      type(particle_set_t), intent(inout) :: particles
+      integer, intent(inout) :: corrections
+      integer :: p, k
+      real(rp) :: sense, x0
+      k = wall%axis
+      sense = wall%normal(k)
+      x0 = wall%point(k)
+      do p = 1, particles%count
+         if (sense * (particles%x(k, p) - x0) < 0.0_rp) then
+            particles%x(k, p) = x0
+            if (sense * particles%v(k, p) < 0.0_rp) particles%v(k, p) = 0.0_rp
+            corrections = corrections + 1
+         end if
+      end do
+   end subroutine keep_inside_axis_wall
 end module boundary_walls

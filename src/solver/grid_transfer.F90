@@ -10,7 +10,7 @@ module grid_transfer
    implicit none
    private
 
-   public :: particles_to_grid, momentum_to_grid, grid_to_particles
+   public :: particles_to_grid, update_velocity_and_remap, grid_to_particles
 
 contains
 
@@ -28,18 +28,20 @@ contains
       end if
    end subroutine particles_to_grid
 
-   !> MUSL re-map: momentum(:, i) = sum N m_p v_p with the updated particle velocities.
-   subroutine momentum_to_grid(grid, particles, momentum)
+   !> MUSL, first half of step 7 fused with the re-map: v_p := alpha (v_p + sum N dv_i) + (1 - alpha) sum N
+   !> v_i^{n+1}, then momentum(:, i) = sum N m_p v_p with the updated velocities (both at x^n).
+   subroutine update_velocity_and_remap(grid, particles, flip_fraction, momentum)
       type(grid_t), intent(in) :: grid
-      type(particle_set_t), intent(in) :: particles
+      type(particle_set_t), intent(inout) :: particles
+      real(rp), intent(in) :: flip_fraction
       real(rp), intent(out) :: momentum(:, :)
       momentum = 0.0_rp
       if (grid%dim == 2) then
-         call momentum_to_grid_2d(grid, particles, momentum)
+         call momentum_to_grid_2d(grid, particles, flip_fraction, momentum)
       else
-         call momentum_to_grid_3d(grid, particles, momentum)
+         call momentum_to_grid_3d(grid, particles, flip_fraction, momentum)
       end if
-   end subroutine momentum_to_grid
+   end subroutine update_velocity_and_remap
 
    !> Steps 3 and 7 at x^n. With v_i^{n+theta} = v_i^{n+1} - (1 - theta) dv_i:
    !>   L_p = sum v_i^{n+theta} (x) grad N_i  -> strain_rate = sym(L), spin = skew(L)   (if compute_strain)

@@ -17,7 +17,7 @@ module mpm_solver
    use node_halo, only: sum_shared_nodes
    use particle_set, only: particle_set_t
    use particle_seeding, only: seed_bodies
-   use particle_sorting, only: sort_by_material_and_cell, update_cells
+   use particle_sorting, only: sort_by_material_and_cell, update_cells, set_material_ranges
    use particle_migration, only: migrate_particles
    use material_model, only: material_slot_t
    use material_factory, only: build_materials
@@ -25,7 +25,7 @@ module mpm_solver
    use stabilizer, only: stabilizer_slot_t
    use stabilizer_factory, only: build_stabilizers
    use boundary_walls, only: wall_t, build_box_walls, apply_wall_constraints, keep_particles_inside
-   use grid_transfer, only: particles_to_grid, momentum_to_grid, grid_to_particles
+   use grid_transfer, only: particles_to_grid, update_velocity_and_remap, grid_to_particles
    use run_diagnostics, only: diagnostics_t, compute_diagnostics
    use status_broadcast, only: agree_on_status
    implicit none
@@ -82,6 +82,7 @@ contains
 
       call self%particles%init(scene%grid%dim, size(scene%materials), 1024)
       call seed_bodies(scene, self%grid, self%domain, self%particles)
+      call update_cells(self%grid, self%particles)
       call sort_by_material_and_cell(self%grid, self%particles)
       if (self%musl) allocate (self%remapped_momentum(self%grid%dim, self%grid%node_count))
 
@@ -113,8 +114,6 @@ contains
 
       associate (run => self%run)
          if (self%musl) then
-            call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
-                                   update_velocity=.true., compute_strain=.false., update_position=.false.)
             call remap_velocities(self)
             call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
                                    update_velocity=.false., compute_strain=.true., update_position=.true., &
@@ -145,11 +144,11 @@ contains
       call keep_particles_inside(self%walls, self%particles, self%wall_corrections)
       call migrate_particles(self%domain, self%grid, self%particles, self%lost_particles, arrived)
       ! arrivals are appended at the end: re-sort so materials stay contiguous; otherwise re-sort now and
-      ! then for memory locality and only refresh the cells in between
+      ! then for memory locality (removals keep the grouping of the rest)
       if (arrived > 0 .or. mod(self%step + 1, int(sort_interval, i8)) == 0) then
          call sort_by_material_and_cell(self%grid, self%particles)
       else
-         call update_cells(self%grid, self%particles)
+         call set_material_ranges(self%particles)
       end if
 
       self%time = self%time + dt
@@ -182,12 +181,12 @@ contains
       end associate
    end subroutine update_nodes
 
-   !> MUSL: nodal velocities from the momentum of the updated particle velocities, with walls.
+   !> MUSL: update the particle velocities, then nodal velocities from their momentum, with walls.
    subroutine remap_velocities(self)
       type(solver_t), intent(inout) :: self
       integer :: i
       real(rp) :: m
-      call momentum_to_grid(self%grid, self%particles, self%remapped_momentum)
+      call update_velocity_and_remap(self%grid, self%particles, self%run%flip_fraction, self%remapped_momentum)
       call sum_shared_nodes(self%domain, self%grid, self%remapped_momentum)
       do i = 1, self%grid%node_count
          m = self%grid%accumulated(row_mass, i)
