@@ -28,6 +28,7 @@ module particle_set
    contains
       procedure :: init => particles_init
       procedure :: reserve => particles_reserve
+      procedure :: reorder => particles_reorder
       procedure :: record_size => particles_record_size
       procedure :: pack_record => particles_pack_record
       procedure :: append_record => particles_append_record
@@ -73,56 +74,78 @@ contains
    subroutine particles_reserve(self, capacity)
       class(particle_set_t), intent(inout) :: self
       integer, intent(in) :: capacity
-      integer :: n
-      n = self%count
+      integer :: p
       if (capacity <= size(self%mass)) return
-      call grow_real2(self%x, capacity, n)
-      call grow_real2(self%v, capacity, n)
-      call grow_real1(self%mass, capacity, n)
-      call grow_real1(self%density, capacity, n)
-      call grow_real2(self%sbar, capacity, n)
-      call grow_int1(self%material, capacity, n)
-      call grow_i8(self%id, capacity, n)
-      call grow_int1(self%cell, capacity, n)
-      call grow_real2(self%strain_rate, capacity, n)
-      call grow_real2(self%spin, capacity, n)
+      call self%reorder([(p, p = 1, self%count)], capacity)
    end subroutine particles_reserve
 
-   subroutine grow_real2(a, capacity, n)
+   !> Move particle p to slot dest(p) (a permutation of 1..count) in arrays of `capacity` slots.
+   !> The scratch arrays (rate of deformation, spin) are not carried: they are rebuilt every step.
+   subroutine particles_reorder(self, dest, capacity)
+      class(particle_set_t), intent(inout) :: self
+      integer, intent(in) :: dest(:), capacity
+      call reorder_real2(self%x, dest, capacity)
+      call reorder_real2(self%v, dest, capacity)
+      call reorder_real1(self%mass, dest, capacity)
+      call reorder_real1(self%density, dest, capacity)
+      call reorder_real2(self%sbar, dest, capacity)
+      call reorder_int1(self%material, dest, capacity)
+      call reorder_int1(self%cell, dest, capacity)
+      call reorder_i8(self%id, dest, capacity)
+      if (capacity /= size(self%strain_rate, 2)) then
+         deallocate (self%strain_rate, self%spin)
+         allocate (self%strain_rate(self%n_sigma, capacity), self%spin(self%n_spin, capacity))
+      end if
+   end subroutine particles_reorder
+
+   ! One routine per array type (Fortran has no generics over types): b(dest(p)) = a(p).
+   subroutine reorder_real2(a, dest, capacity)
       real(rp), allocatable, intent(inout) :: a(:, :)
-      integer, intent(in) :: capacity, n
+      integer, intent(in) :: dest(:), capacity
       real(rp), allocatable :: b(:, :)
+      integer :: p
       allocate (b(size(a, 1), capacity))
-      b(:, 1:n) = a(:, 1:n)
+      do p = 1, size(dest)
+         b(:, dest(p)) = a(:, p)
+      end do
       call move_alloc(b, a)
-   end subroutine grow_real2
+   end subroutine reorder_real2
 
-   subroutine grow_real1(a, capacity, n)
+   subroutine reorder_real1(a, dest, capacity)
       real(rp), allocatable, intent(inout) :: a(:)
-      integer, intent(in) :: capacity, n
+      integer, intent(in) :: dest(:), capacity
       real(rp), allocatable :: b(:)
+      integer :: p
       allocate (b(capacity))
-      b(1:n) = a(1:n)
+      do p = 1, size(dest)
+         b(dest(p)) = a(p)
+      end do
       call move_alloc(b, a)
-   end subroutine grow_real1
+   end subroutine reorder_real1
 
-   subroutine grow_int1(a, capacity, n)
+   subroutine reorder_int1(a, dest, capacity)
       integer, allocatable, intent(inout) :: a(:)
-      integer, intent(in) :: capacity, n
+      integer, intent(in) :: dest(:), capacity
       integer, allocatable :: b(:)
+      integer :: p
       allocate (b(capacity))
-      b(1:n) = a(1:n)
+      do p = 1, size(dest)
+         b(dest(p)) = a(p)
+      end do
       call move_alloc(b, a)
-   end subroutine grow_int1
+   end subroutine reorder_int1
 
-   subroutine grow_i8(a, capacity, n)
+   subroutine reorder_i8(a, dest, capacity)
       integer(i8), allocatable, intent(inout) :: a(:)
-      integer, intent(in) :: capacity, n
+      integer, intent(in) :: dest(:), capacity
       integer(i8), allocatable :: b(:)
+      integer :: p
       allocate (b(capacity))
-      b(1:n) = a(1:n)
+      do p = 1, size(dest)
+         b(dest(p)) = a(p)
+      end do
       call move_alloc(b, a)
-   end subroutine grow_i8
+   end subroutine reorder_i8
 
    !> Reals needed to carry one particle's persistent state between ranks.
    pure integer function particles_record_size(self)

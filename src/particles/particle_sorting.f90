@@ -2,7 +2,6 @@
 !> and stabilization loops, and cell order inside each slice so that grid access is local.
 !> A counting sort: O(particles + materials * local cells).
 module particle_sorting
-   use kinds, only: rp, i8
    use background_grid, only: grid_t
    use particle_set, only: particle_set_t
    implicit none
@@ -50,14 +49,7 @@ contains
          dest(p) = start(key(p))
       end do
 
-      call permute_real2(particles%x, dest, n)
-      call permute_real2(particles%v, dest, n)
-      call permute_real1(particles%mass, dest, n)
-      call permute_real1(particles%density, dest, n)
-      call permute_real2(particles%sbar, dest, n)
-      call permute_int1(particles%material, dest, n)
-      call permute_int1(particles%cell, dest, n)
-      call permute_i8(particles%id, dest, n)
+      call particles%reorder(dest, size(particles%mass))
 
       call set_material_ranges(particles)
    end subroutine sort_by_material_and_cell
@@ -79,51 +71,4 @@ contains
       end do
    end subroutine set_material_ranges
 
-   subroutine permute_real2(a, dest, n)
-      real(rp), intent(inout) :: a(:, :)
-      integer, intent(in) :: dest(:), n
-      real(rp), allocatable :: b(:, :)
-      integer :: p
-      allocate (b(size(a, 1), n))
-      do p = 1, n
-         b(:, dest(p)) = a(:, p)
-      end do
-      a(:, 1:n) = b
-   end subroutine permute_real2
-
-   subroutine permute_real1(a, dest, n)
-      real(rp), intent(inout) :: a(:)
-      integer, intent(in) :: dest(:), n
-      real(rp), allocatable :: b(:)
-      integer :: p
-      allocate (b(n))
-      do p = 1, n
-         b(dest(p)) = a(p)
-      end do
-      a(1:n) = b
-   end subroutine permute_real1
-
-   subroutine permute_int1(a, dest, n)
-      integer, intent(inout) :: a(:)
-      integer, intent(in) :: dest(:), n
-      integer, allocatable :: b(:)
-      integer :: p
-      allocate (b(n))
-      do p = 1, n
-         b(dest(p)) = a(p)
-      end do
-      a(1:n) = b
-   end subroutine permute_int1
-
-   subroutine permute_i8(a, dest, n)
-      integer(i8), intent(inout) :: a(:)
-      integer, intent(in) :: dest(:), n
-      integer(i8), allocatable :: b(:)
-      integer :: p
-      allocate (b(n))
-      do p = 1, n
-         b(dest(p)) = a(p)
-      end do
-      a(1:n) = b
-   end subroutine permute_i8
 end module particle_sorting
