@@ -1,56 +1,92 @@
-!> Flotsam driver: `mpirun -np N flotsam scene.nml [--overwrite]`.
+!> Flotsam driver: `mpirun -np N flotsam scene.nml [--overwrite] [--restart <checkpoint>|latest]`.
 !> The only place that touches MPI_COMM_WORLD and the only place that stops the program.
+!>
+!> Exit codes: 0 done; 2 scene, set-up or checkpoint refused; 3 output folder; 4 failure during the
+!> run (including a blow-up); 5 stopped by SIGTERM/SIGINT after writing a checkpoint.
 program flotsam
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use mpi_f08, only: MPI_Init, MPI_Finalize, MPI_Comm_rank, MPI_COMM_WORLD
+   use kinds, only: path_len
    use error_status, only: status_t
    use scene_description, only: scene_t
    use scene_reader, only: read_scene
-   use output_directory, only: prepare_output_directory
+   use output_directory, only: prepare_output_directory, prepare_restart_directory
    use mpm_solver, only: solver_t
+   use run_progress, only: run_progress_t
+   use checkpoint, only: read_checkpoint, latest_checkpoint_path
+   use status_broadcast, only: broadcast_status
    use simulation, only: run_simulation
    implicit none
+
+   integer, parameter :: exit_scene = 2, exit_output_folder = 3, exit_run = 4, exit_signal = 5
 
    type(scene_t) :: scene
    type(status_t) :: status
    type(solver_t) :: solver
-   character(len=:), allocatable :: scene_path
+   type(run_progress_t) :: progress
+   character(len=:), allocatable :: scene_path, restart_path
    logical :: overwrite
-   integer :: rank, exit_code
+   integer :: rank, exit_code, stopped_by
 
    call MPI_Init()
    call MPI_Comm_rank(MPI_COMM_WORLD, rank)
-   call parse_command_line(scene_path, overwrite, exit_code)
+   call parse_command_line(scene_path, overwrite, restart_path, exit_code)
    if (exit_code >= 0) call finish(exit_code)
 
    call read_scene(scene_path, MPI_COMM_WORLD, scene, status)
-   if (.not. status%ok) call fail(status, 2)
+   if (.not. status%ok) call fail(status, exit_scene)
    if (overwrite) scene%run%overwrite = .true.
 
-   call solver%init(scene, MPI_COMM_WORLD, status)
-   if (.not. status%ok) call fail(status, 2)
-   call prepare_output_directory(scene%run%output_dir, scene%run%overwrite, MPI_COMM_WORLD, status)
-   if (.not. status%ok) call fail(status, 3)
+   if (len(restart_path) == 0) then
+      call solver%init(scene, MPI_COMM_WORLD, status)
+      if (.not. status%ok) call fail(status, exit_scene)
+      call prepare_output_directory(scene%run%output_dir, scene%run%overwrite, MPI_COMM_WORLD, status)
+      if (.not. status%ok) call fail(status, exit_output_folder)
+   else
+      call solver%init(scene, MPI_COMM_WORLD, status, seed_particles=.false.)
+      if (.not. status%ok) call fail(status, exit_scene)
+      call prepare_restart_directory(scene%run%output_dir, MPI_COMM_WORLD, status)
+      if (.not. status%ok) call fail(status, exit_output_folder)
+      call resolve_restart_path(restart_path, status)
+      call read_checkpoint(restart_path, scene, solver, progress, status)
+      if (.not. status%ok) call fail(status, exit_scene)
+      if (rank == 0) write (error_unit, '(a,i0,a,es12.5,a)') 'flotsam: continuing '//restart_path//' from step ', &
+         solver%step, ' (t = ', solver%time, ' s)'
+   end if
 
-   call run_simulation(solver, status)
-   if (.not. status%ok) call fail(status, 4)
+   call run_simulation(solver, progress, status, stopped_by)
+   if (stopped_by > 0) then
+      if (rank == 0) write (error_unit, '(a)') 'flotsam: '//trim(status%message)
+      call finish(exit_signal)
+   end if
+   if (.not. status%ok) call fail(status, exit_run)
    call solver%free()
    call finish(0)
 
 contains
 
-   !> Read `flotsam <scene.nml> [--overwrite]`. exit_code >= 0 means: stop now with that code.
-   subroutine parse_command_line(path, overwrite, exit_code)
-      character(len=:), allocatable, intent(out) :: path
+   !> Read `flotsam <scene.nml> [--overwrite] [--restart <checkpoint>]`. exit_code >= 0 means: stop now
+   !> with that code.
+   subroutine parse_command_line(path, overwrite, restart, exit_code)
+      character(len=:), allocatable, intent(out) :: path, restart
       logical, intent(out) :: overwrite
       integer, intent(out) :: exit_code
       character(len=4096) :: arg
       integer :: i
+      logical :: restart_follows, restart_given
       overwrite = .false.
+      restart_given = .false.
       exit_code = -1
       path = ''
+      restart = ''
+      restart_follows = .false.
       do i = 1, command_argument_count()
          call get_command_argument(i, arg)
+         if (restart_follows) then
+            restart = trim(arg)
+            restart_follows = .false.
+            cycle
+         end if
          select case (trim(arg))
          case ('-h', '--help')
             if (rank == 0) call print_usage(output_unit)
@@ -58,27 +94,65 @@ contains
             return
          case ('--overwrite')
             overwrite = .true.
+         case ('--restart')
+            restart_follows = .true.
+            restart_given = .true.
          case default
-            if (arg(1:1) == '-' .or. len(path) > 0) then
+            if (arg(1:10) == '--restart=') then
+               restart = trim(arg(11:))
+               restart_given = .true.
+            else if (arg(1:1) == '-' .or. len(path) > 0) then
                if (rank == 0) write (error_unit, '(a)') 'flotsam: error: unexpected argument '//trim(arg)
-               exit_code = 2
+               exit_code = exit_scene
                return
+            else
+               path = trim(arg)
             end if
-            path = trim(arg)
          end select
       end do
-      if (len(path) == 0) then
+      if (restart_given .and. len(restart) == 0) then
+         if (rank == 0) write (error_unit, '(a)') 'flotsam: error: --restart needs a checkpoint file (or latest)'
+         exit_code = exit_scene
+      else if (len(path) == 0) then
          if (rank == 0) call print_usage(error_unit)
-         exit_code = 2
+         exit_code = exit_scene
+      else if (len(restart) > 0 .and. overwrite) then
+         if (rank == 0) write (error_unit, '(a)') 'flotsam: error: --restart continues a run; it cannot be '// &
+            'combined with --overwrite'
+         exit_code = exit_scene
       end if
    end subroutine parse_command_line
 
+   !> `--restart latest` names the newest checkpoint of the scene's output folder. Collective.
+   subroutine resolve_restart_path(path, status)
+      character(len=:), allocatable, intent(inout) :: path
+      type(status_t), intent(inout) :: status
+      character(len=path_len) :: resolved
+      if (path /= 'latest') return
+      resolved = ''
+      if (rank == 0) resolved = latest_checkpoint_path(scene%run%output_dir, status)
+      call broadcast_status(status, MPI_COMM_WORLD, 0)
+      if (.not. status%ok) call fail(status, exit_scene)
+      call broadcast_path(resolved)
+      path = trim(resolved)
+   end subroutine resolve_restart_path
+
+   subroutine broadcast_path(text)
+      use mpi_f08, only: MPI_Bcast, MPI_CHARACTER
+      character(len=*), intent(inout) :: text
+      call MPI_Bcast(text, len(text), MPI_CHARACTER, 0, MPI_COMM_WORLD)
+   end subroutine broadcast_path
+
    subroutine print_usage(unit)
       integer, intent(in) :: unit
-      write (unit, '(a)') 'usage: mpirun -np N flotsam <scene.nml> [--overwrite]', &
-         '  <scene.nml>   scene file of Fortran namelists (see docs/input.md)', &
-         '  --overwrite   allow replacing a previous run in the output folder', &
-         '  -h, --help    print this text'
+      write (unit, '(a)') 'usage: mpirun -np N flotsam <scene.nml> [--overwrite] [--restart <checkpoint>]', &
+         '  <scene.nml>               scene file of Fortran namelists (see docs/input.md)', &
+         '  --overwrite               replace a previous run in the output folder', &
+         '  --restart <checkpoint>    continue the run from a checkpoint file of its output folder;', &
+         '                            --restart latest takes the newest one (see docs/output.md)', &
+         '  -h, --help                print this text', &
+         'exit codes: 0 done, 2 scene or checkpoint refused, 3 output folder, 4 run failed,', &
+         '            5 stopped by SIGTERM/SIGINT (a checkpoint was written)'
    end subroutine print_usage
 
    !> Every rank holds the same failed status: rank 0 reports it, all ranks exit with `code`.

@@ -23,11 +23,17 @@ module scene_description
       character(len=path_len) :: output_dir = 'output'
       logical :: overwrite = .false.          !< allow replacing a previous run in output_dir
       character(len=name_len) :: update_scheme = 'MUSL'  !< 'MUSL' (default) or 'USL'
-      real(rp) :: flip_fraction = 1.0_rp      !< 1: pure FLIP, 0: pure PIC
+      real(rp) :: flip_fraction = 0.95_rp     !< 1: pure FLIP, 0: pure PIC (default: docs/theory.md)
       real(rp) :: theta = 1.0_rp              !< theta of the nodal velocity used for kinematics
       integer(i8) :: max_steps = huge(1_i8)   !< stop after this many steps
       real(rp) :: progress_interval = 5.0_rp  !< wall seconds between progress lines on stderr; <= 0: none
       real(rp) :: floor_size = 0.0_rp         !< tank floor width (2-D) / area (3-D) for h_eq; 0: from grid
+      logical :: particle_output = .true.     !< write particle fields (HDF5 + XDMF) at every output time
+      logical :: grid_output = .true.         !< write grid fields of the active box at every output time
+      integer(i8) :: checkpoint_interval_steps = 0   !< steps between checkpoints; 0: not by steps
+      real(rp) :: checkpoint_interval_wall = 3600.0_rp  !< wall seconds between checkpoints; 0: not by time
+      integer :: checkpoints_kept = 2         !< newest checkpoints kept on disk
+      real(rp) :: speed_limit = 0.0_rp        !< particle speed taken as a blow-up [m/s]; 0: 10 x fastest wave
    end type run_control_t
 
    !> `&grid` and `&box_walls`: the background grid in its own frame, and its walls.
@@ -51,6 +57,11 @@ module scene_description
       real(rp) :: youngs_modulus = 0.0_rp     !< solid E [Pa]
       real(rp) :: poisson_ratio = 0.0_rp      !< solid nu [-]
       character(len=name_len) :: stabilization = 'none'   !< anti-locking / smoothing scheme
+      logical :: volumetric_only = .false.    !< C0: average only the volumetric parts (B-bar-like)
+      character(len=name_len) :: oscillation_rule = 'OR'  !< FOAL1: 'OR' or 'AND' of the two cells' flags
+      real(rp) :: gamma_max = 1.0_rp          !< FOAL1: flux tuning coefficient in [0, 1]
+      character(len=name_len) :: smoothed_variables = 'stress'   !< FOAL1: 'stress' (all components) or 'pressure'
+      logical :: cell_averaging = .true.      !< FOAL1: replace particle values by the cell average first
    end type material_spec_t
 
    !> `&body`: a rectangle (2-D) or box (3-D) of one material filled with particles.

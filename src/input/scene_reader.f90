@@ -13,7 +13,7 @@ module scene_reader
    use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, &
                                 model_newtonian_fluid, model_linear_elastic
    use namelist_scan, only: namelist_file_t, namelist_group_t, scan_namelist_file
-   use scene_validation, only: validate_scene, resolve_scene, stabilization_keywords
+   use scene_validation, only: validate_scene, resolve_scene, stabilization_keywords, oscillation_rule_keywords
    use scene_broadcast, only: broadcast_scene
    use status_broadcast, only: broadcast_status
    use input_text, only: lower_case, upper_case, int_text, ordinal, group_context, canonical_keyword
@@ -37,7 +37,7 @@ module scene_reader
    !> The variables of every group: their kind names the expected value in messages.
    type :: variable_info_t
       character(len=9) :: group
-      character(len=18) :: name
+      character(len=26) :: name
       character(len=7) :: kind          !< real, real3, integer, logical or string
       logical :: required
    end type variable_info_t
@@ -55,6 +55,12 @@ module scene_reader
       variable_info_t('run', 'max_steps', 'integer', .false.), &
       variable_info_t('run', 'progress_interval', 'real', .false.), &
       variable_info_t('run', 'floor_size', 'real', .false.), &
+      variable_info_t('run', 'particle_output', 'logical', .false.), &
+      variable_info_t('run', 'grid_output', 'logical', .false.), &
+      variable_info_t('run', 'checkpoint_interval_steps', 'integer', .false.), &
+      variable_info_t('run', 'checkpoint_interval_wall', 'real', .false.), &
+      variable_info_t('run', 'checkpoints_kept', 'integer', .false.), &
+      variable_info_t('run', 'speed_limit', 'real', .false.), &
       variable_info_t('grid', 'dim', 'integer', .false.), &
       variable_info_t('grid', 'cell_size', 'real', .true.), &
       variable_info_t('grid', 'origin', 'real3', .false.), &
@@ -74,6 +80,11 @@ module scene_reader
       variable_info_t('material', 'youngs_modulus', 'real', .false.), &
       variable_info_t('material', 'poisson_ratio', 'real', .false.), &
       variable_info_t('material', 'stabilization', 'string', .false.), &
+      variable_info_t('material', 'volumetric_only', 'logical', .false.), &
+      variable_info_t('material', 'oscillation_rule', 'string', .false.), &
+      variable_info_t('material', 'gamma_max', 'real', .false.), &
+      variable_info_t('material', 'smoothed_variables', 'string', .false.), &
+      variable_info_t('material', 'cell_averaging', 'logical', .false.), &
       variable_info_t('body', 'material', 'string', .true.), &
       variable_info_t('body', 'lower', 'real3', .true.), &
       variable_info_t('body', 'upper', 'real3', .true.), &
@@ -481,12 +492,15 @@ contains
       character(len=*), intent(inout) :: message
       integer, intent(in), optional :: unit
       character(len=*), intent(in), optional :: text
-      real(rp) :: end_time, cfl, dt, output_interval, flip_fraction, theta, progress_interval, floor_size
+      real(rp) :: end_time, cfl, dt, output_interval, flip_fraction, theta, progress_interval, floor_size, &
+                  checkpoint_interval_wall, speed_limit
       character(len=text_len) :: output_dir, update_scheme
-      logical :: overwrite
-      integer(i8) :: max_steps
+      logical :: overwrite, particle_output, grid_output
+      integer(i8) :: max_steps, checkpoint_interval_steps
+      integer :: checkpoints_kept
       namelist /run/ end_time, cfl, dt, output_interval, output_dir, overwrite, update_scheme, flip_fraction, &
-         theta, max_steps, progress_interval, floor_size
+         theta, max_steps, progress_interval, floor_size, particle_output, grid_output, checkpoint_interval_steps, &
+         checkpoint_interval_wall, checkpoints_kept, speed_limit
 
       end_time = control%end_time
       cfl = control%cfl
@@ -500,6 +514,12 @@ contains
       max_steps = control%max_steps
       progress_interval = control%progress_interval
       floor_size = control%floor_size
+      particle_output = control%particle_output
+      grid_output = control%grid_output
+      checkpoint_interval_steps = control%checkpoint_interval_steps
+      checkpoint_interval_wall = control%checkpoint_interval_wall
+      checkpoints_kept = control%checkpoints_kept
+      speed_limit = control%speed_limit
       if (present(text)) then
          read (text, nml=run, iostat=ios, iomsg=message)
       else
@@ -520,6 +540,12 @@ contains
       control%max_steps = max_steps
       control%progress_interval = progress_interval
       control%floor_size = floor_size
+      control%particle_output = particle_output
+      control%grid_output = grid_output
+      control%checkpoint_interval_steps = checkpoint_interval_steps
+      control%checkpoint_interval_wall = checkpoint_interval_wall
+      control%checkpoints_kept = checkpoints_kept
+      control%speed_limit = speed_limit
    end subroutine read_run_group
 
    subroutine read_grid_group(spec, ios, message, unit, text)
@@ -608,9 +634,11 @@ contains
       character(len=*), intent(inout) :: message
       integer, intent(in), optional :: unit
       character(len=*), intent(in), optional :: text
-      character(len=text_len) :: name, model, stabilization
-      real(rp) :: density, bulk_modulus, viscosity, youngs_modulus, poisson_ratio
-      namelist /material/ name, model, density, bulk_modulus, viscosity, youngs_modulus, poisson_ratio, stabilization
+      character(len=text_len) :: name, model, stabilization, oscillation_rule, smoothed_variables
+      real(rp) :: density, bulk_modulus, viscosity, youngs_modulus, poisson_ratio, gamma_max
+      logical :: volumetric_only, cell_averaging
+      namelist /material/ name, model, density, bulk_modulus, viscosity, youngs_modulus, poisson_ratio, stabilization, &
+         volumetric_only, oscillation_rule, gamma_max, smoothed_variables, cell_averaging
 
       name = spec%name
       model = spec%model
@@ -620,6 +648,11 @@ contains
       youngs_modulus = spec%youngs_modulus
       poisson_ratio = spec%poisson_ratio
       stabilization = spec%stabilization
+      volumetric_only = spec%volumetric_only
+      oscillation_rule = spec%oscillation_rule
+      gamma_max = spec%gamma_max
+      smoothed_variables = spec%smoothed_variables
+      cell_averaging = spec%cell_averaging
       if (present(text)) then
          read (text, nml=material, iostat=ios, iomsg=message)
       else
@@ -628,6 +661,8 @@ contains
       call check_length('name', name, len(spec%name), ios, message)
       call check_length('model', model, len(spec%model), ios, message)
       call check_length('stabilization', stabilization, len(spec%stabilization), ios, message)
+      call check_length('oscillation_rule', oscillation_rule, len(spec%oscillation_rule), ios, message)
+      call check_length('smoothed_variables', smoothed_variables, len(spec%smoothed_variables), ios, message)
       if (ios /= 0) return
       spec%name = name(1:len(spec%name))
       spec%model = lower_case(adjustl(model))
@@ -637,6 +672,11 @@ contains
       spec%youngs_modulus = youngs_modulus
       spec%poisson_ratio = poisson_ratio
       spec%stabilization = canonical_keyword(adjustl(stabilization), stabilization_keywords)
+      spec%volumetric_only = volumetric_only
+      spec%oscillation_rule = canonical_keyword(adjustl(oscillation_rule), oscillation_rule_keywords)
+      spec%gamma_max = gamma_max
+      spec%smoothed_variables = lower_case(adjustl(smoothed_variables))
+      spec%cell_averaging = cell_averaging
    end subroutine read_material_group
 
    subroutine read_body_group(spec, ios, message, unit, text)

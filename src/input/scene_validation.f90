@@ -15,6 +15,9 @@ module scene_validation
 
    !> Accepted `&material stabilization=` keywords in their canonical spelling (compared without case).
    character(len=*), parameter, public :: stabilization_keywords(*) = [character(len=5) :: 'none', 'C0', 'NB', 'FOAL1']
+   !> Accepted `&material oscillation_rule=` and `smoothed_variables=` keywords (FOAL1 options).
+   character(len=*), parameter, public :: oscillation_rule_keywords(*) = [character(len=3) :: 'OR', 'AND']
+   character(len=*), parameter, public :: smoothed_variables_keywords(*) = [character(len=8) :: 'stress', 'pressure']
    !> Accepted `&run update_scheme=` keywords (stored upper case).
    character(len=*), parameter, public :: update_scheme_keywords(*) = [character(len=4) :: 'USL', 'MUSL']
    !> Accepted `&box_walls` keywords (stored lower case).
@@ -129,6 +132,15 @@ contains
       end if
       call check_real(where, 'progress_interval', run%progress_interval, status)
       call check_real(where, 'floor_size', run%floor_size, status, at_least=0.0_rp)
+      if (run%checkpoint_interval_steps < 0_i8) then
+         call status%fail(where//': variable checkpoint_interval_steps must be >= 0, got '// &
+                          int_text(run%checkpoint_interval_steps))
+      end if
+      call check_real(where, 'checkpoint_interval_wall', run%checkpoint_interval_wall, status, at_least=0.0_rp)
+      if (run%checkpoints_kept < 1) then
+         call status%fail(where//': variable checkpoints_kept must be >= 1, got '//int_text(run%checkpoints_kept))
+      end if
+      call check_real(where, 'speed_limit', run%speed_limit, status, at_least=0.0_rp)
    end subroutine validate_run
 
    subroutine validate_grid(grid, path, status)
@@ -259,6 +271,15 @@ contains
             call status%fail(where//': variable stabilization must be one of '//quoted_list(stabilization_keywords)// &
                              ", got '"//trim(material%stabilization)//"'")
          end if
+         if (all(material%oscillation_rule /= oscillation_rule_keywords)) then
+            call status%fail(where//': variable oscillation_rule must be one of '// &
+                             quoted_list(oscillation_rule_keywords)//", got '"//trim(material%oscillation_rule)//"'")
+         end if
+         if (all(material%smoothed_variables /= smoothed_variables_keywords)) then
+            call status%fail(where//': variable smoothed_variables must be one of '// &
+                             quoted_list(smoothed_variables_keywords)//", got '"//trim(material%smoothed_variables)//"'")
+         end if
+         call check_real(where, 'gamma_max', material%gamma_max, status, at_least=0.0_rp, at_most=1.0_rp)
       end associate
    end subroutine validate_material
 

@@ -1,8 +1,14 @@
-!> A CSV file written row by row and flushed after each row, so a killed run leaves whole rows only.
+!> A CSV file written row by row and flushed after each row, so a killed run leaves at most one partial
+!> row, at the end; `keep_rows_until` cuts a file back to the rows of a restart point.
 module csv_writer
+   use kinds, only: i8
    use error_status, only: status_t
+   use file_system, only: rename_path
+   use output_layout, only: temporary_suffix
    implicit none
    private
+
+   public :: keep_rows_until
 
    type, public :: csv_writer_t
       integer :: unit = 0
@@ -15,19 +21,28 @@ module csv_writer
 
 contains
 
-   subroutine csv_open(self, path, header, status)
+   !> Start `path` with the `header` row, or with `append`, continue an existing file after its last row.
+   subroutine csv_open(self, path, header, status, append)
       class(csv_writer_t), intent(inout) :: self
       character(len=*), intent(in) :: path, header
       type(status_t), intent(inout) :: status
+      logical, intent(in), optional :: append
       integer :: ios
+      logical :: continuing
       character(len=256) :: msg
-      open (newunit=self%unit, file=path, status='replace', action='write', iostat=ios, iomsg=msg)
+      continuing = .false.
+      if (present(append)) continuing = append
+      if (continuing) then
+         open (newunit=self%unit, file=path, status='old', position='append', action='write', iostat=ios, iomsg=msg)
+      else
+         open (newunit=self%unit, file=path, status='replace', action='write', iostat=ios, iomsg=msg)
+      end if
       if (ios /= 0) then
          call status%fail('cannot open '//trim(path)//': '//trim(msg))
          return
       end if
       self%is_open = .true.
-      call self%write_row(header)
+      if (.not. continuing) call self%write_row(header)
    end subroutine csv_open
 
    subroutine csv_write_row(self, line)
@@ -43,4 +58,59 @@ contains
       if (self%is_open) close (self%unit)
       self%is_open = .false.
    end subroutine csv_close
+
+   !> Keep the header of CSV file `path` and its leading rows whose integer in column `column` is
+   !> <= `last`; drop the rest (rows of a run continued from an earlier point, a partial last row).
+   !> The file is rewritten under a temporary name and renamed.
+   subroutine keep_rows_until(path, column, last, status)
+      character(len=*), intent(in) :: path
+      integer, intent(in) :: column
+      integer(i8), intent(in) :: last
+      type(status_t), intent(inout) :: status
+      integer :: input, output, ios, ios_read, first, k, fields
+      integer(i8) :: value
+      character(len=4096) :: line
+      character(len=256) :: msg
+      open (newunit=input, file=path, status='old', action='read', iostat=ios, iomsg=msg)
+      if (ios /= 0) then
+         call status%fail('cannot read '//path//' to continue it: '//trim(msg))
+         return
+      end if
+      open (newunit=output, file=path//temporary_suffix, status='replace', action='write', iostat=ios, iomsg=msg)
+      if (ios /= 0) then
+         close (input)
+         call status%fail('cannot write '//path//temporary_suffix//': '//trim(msg))
+         return
+      end if
+      read (input, '(a)', iostat=ios) line
+      if (ios == 0) write (output, '(a)') trim(line)
+      fields = count_commas(line)
+      do
+         read (input, '(a)', iostat=ios) line
+         if (ios /= 0) exit
+         if (count_commas(line) /= fields) exit      ! a row cut short by a crash
+         ! the field after the (column - 1)-th comma
+         first = 1
+         do k = 1, column - 1
+            first = first + index(line(first:), ',')
+         end do
+         value = huge(value)
+         k = index(line(first:), ',')
+         if (first > 1 .and. k > 1) read (line(first:first + k - 2), *, iostat=ios_read) value
+         if (value > last) exit
+         write (output, '(a)') trim(line)
+      end do
+      close (input)
+      close (output)
+      if (.not. rename_path(path//temporary_suffix, path)) call status%fail('cannot rename '//path//temporary_suffix)
+   end subroutine keep_rows_until
+
+   pure integer function count_commas(line)
+      character(len=*), intent(in) :: line
+      integer :: i
+      count_commas = 0
+      do i = 1, len_trim(line)
+         if (line(i:i) == ',') count_commas = count_commas + 1
+      end do
+   end function count_commas
 end module csv_writer

@@ -40,6 +40,7 @@ contains
       integer, intent(in) :: dim, global_cells(3)
       type(status_t), intent(inout) :: status
       integer :: dims(dim), order(dim), k, j, tmp
+      integer, allocatable :: uniform(:, :)
       logical :: periods(dim)
       character(len=200) :: msg
 
@@ -62,9 +63,10 @@ contains
          self%dims(order(k)) = dims(k)
       end do
       do k = 1, dim
-         if (self%dims(k) > global_cells(k)) then
+         ! a split axis needs at least two cells per rank: the smoothing's cell halo is two layers deep
+         if (self%dims(k) > 1 .and. 2 * self%dims(k) > global_cells(k)) then
             write (msg, '(a,i0,a,i0,a,i0,a)') 'cannot split ', global_cells(k), ' cells along axis ', k, &
-               ' over ', self%dims(k), ' ranks: use fewer ranks or a finer grid'
+               ' over ', self%dims(k), ' ranks (at least 2 cells per rank): use fewer ranks or a finer grid'
             call status%fail(trim(msg))
             return
          end if
@@ -78,15 +80,16 @@ contains
          call MPI_Cart_shift(self%comm, k - 1, 1, self%neighbour(1, k), self%neighbour(2, k))
       end do
 
-      allocate (self%cuts(0:maxval(self%dims), 3))
-      self%cuts = 0
+      if (allocated(self%cuts)) deallocate (self%cuts)
+      allocate (self%cuts(0:maxval(self%dims), 3), uniform(0:maxval(self%dims), 3))
+      uniform = 0
       do k = 1, 3
          do j = 0, self%dims(k)
             ! uniform split; integer arithmetic keeps every rank's view identical
-            self%cuts(j, k) = int((int(j, i8) * global_cells(k)) / self%dims(k))
+            uniform(j, k) = int((int(j, i8) * global_cells(k)) / self%dims(k))
          end do
       end do
-      call self%set_cuts(self%cuts)
+      call self%set_cuts(uniform)
       if (maxval(self%dims) > max_cuts) call status%fail('too many ranks along one axis')
    end subroutine domain_init
 
@@ -95,7 +98,7 @@ contains
       class(domain_t), intent(inout) :: self
       integer, intent(in) :: cuts(0:, :)
       integer :: k
-      self%cuts = cuts
+      self%cuts(:, :) = cuts
       do k = 1, 3
          self%cell_lo(k) = self%cuts(self%coords(k), k)
          self%cell_hi(k) = self%cuts(self%coords(k) + 1, k) - 1

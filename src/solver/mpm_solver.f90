@@ -22,7 +22,7 @@ module mpm_solver
    use material_model, only: material_slot_t
    use material_factory, only: build_materials
    use newtonian_fluid, only: newtonian_fluid_t
-   use stabilizer, only: stabilizer_slot_t
+   use stabilizer, only: stabilizer_slot_t, stage_context_t
    use stabilizer_factory, only: build_stabilizers
    use boundary_walls, only: wall_t, build_box_walls, apply_wall_constraints, keep_particles_inside
    use grid_transfer, only: particles_to_grid, update_velocity_and_remap, grid_to_particles
@@ -61,12 +61,16 @@ module mpm_solver
 contains
 
    !> Decompose, build the grid, materials, schemes and walls, seed the particles. Collective.
-   subroutine solver_init(self, scene, comm, status)
+   !> With seed_particles = .false. the particle set stays empty: a restart fills it from a checkpoint,
+   !> together with time, step, dt, the counters and mass_tolerance.
+   subroutine solver_init(self, scene, comm, status, seed_particles)
       class(solver_t), intent(inout) :: self
       type(scene_t), intent(in) :: scene
       type(MPI_Comm), intent(in) :: comm
       type(status_t), intent(inout) :: status
+      logical, intent(in), optional :: seed_particles
       real(rp) :: min_mass
+      logical :: seed
 
       self%run = scene%run
       self%gravity = scene%gravity
@@ -81,7 +85,9 @@ contains
       call build_box_walls(scene%grid, self%grid, self%walls)
 
       call self%particles%init(scene%grid%dim, size(scene%materials), 1024)
-      call seed_bodies(scene, self%grid, self%domain, self%particles)
+      seed = .true.
+      if (present(seed_particles)) seed = seed_particles
+      if (seed) call seed_bodies(scene, self%grid, self%domain, self%particles)
       call update_cells(self%grid, self%particles)
       call sort_by_material_and_cell(self%grid, self%particles)
       if (self%musl) allocate (self%remapped_momentum(self%grid%dim, self%grid%node_count))
@@ -98,18 +104,23 @@ contains
 
    !> One explicit step of length self%dt; afterwards self%dt holds the next stable step.
    subroutine solver_advance(self)
-      class(solver_t), intent(inout) :: self
+      class(solver_t), intent(inout), target :: self
       integer :: m, first, last, arrived
       real(rp) :: dt
+      type(stage_context_t) :: context
 
       dt = self%dt
+      context%domain => self%domain
+      context%grid => self%grid
+      context%dt = dt
       call particles_to_grid(self%grid, self%particles, self%gravity)
       call sum_shared_nodes(self%domain, self%grid, self%grid%accumulated)
       call update_nodes(self, dt)
 
       do m = 1, size(self%schemes)
-         if (allocated(self%schemes(m)%scheme)) &
-            call self%schemes(m)%scheme%prepare(self%domain, self%grid, self%particles, dt)
+         if (.not. allocated(self%schemes(m)%scheme)) cycle
+         call set_slice(m)
+         call self%schemes(m)%scheme%prepare(context, self%particles)
       end do
 
       associate (run => self%run)
@@ -125,8 +136,9 @@ contains
       end associate
 
       do m = 1, size(self%schemes)
-         if (allocated(self%schemes(m)%scheme)) &
-            call self%schemes(m)%scheme%filter_strain_rate(self%domain, self%grid, self%particles, dt)
+         if (.not. allocated(self%schemes(m)%scheme)) cycle
+         call set_slice(m)
+         call self%schemes(m)%scheme%filter_strain_rate(context, self%particles)
       end do
       do m = 1, size(self%materials)
          first = self%particles%material_first(m)
@@ -137,8 +149,9 @@ contains
                                                    self%particles%density(first:last), self%particles%sbar(:, first:last))
       end do
       do m = 1, size(self%schemes)
-         if (allocated(self%schemes(m)%scheme)) &
-            call self%schemes(m)%scheme%filter_stress(self%domain, self%grid, self%particles, dt)
+         if (.not. allocated(self%schemes(m)%scheme)) cycle
+         call set_slice(m)
+         call self%schemes(m)%scheme%filter_stress(context, self%particles)
       end do
 
       call keep_particles_inside(self%walls, self%particles, self%wall_corrections)
@@ -154,6 +167,14 @@ contains
       self%time = self%time + dt
       self%step = self%step + 1
       self%dt = self%stable_time_step()
+
+   contains
+
+      subroutine set_slice(material)
+         integer, intent(in) :: material
+         context%first = self%particles%material_first(material)
+         context%last = self%particles%material_last(material)
+      end subroutine set_slice
    end subroutine solver_advance
 
    !> Step 2: v^n = P/m, v^{n+1} = v^n + dt f/m, walls, dv = v^{n+1} - v^n (contains the wall correction).

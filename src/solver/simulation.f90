@@ -1,69 +1,236 @@
-!> The time loop of a run: steps to the end time, a diagnostics row at every output time (the step is
-!> shortened to land on it), progress lines, and a stop on a non-finite state.
+!> The time loop of a run: steps to the end time, and at every output time a diagnostics row and the
+!> fields files (the step is shortened to land on it); checkpoints every N steps, every T seconds of
+!> wall time, at the end and on SIGTERM/SIGINT; a stop within the step in which the solution stops
+!> being finite or blows up (docs/output.md).
+!>
+!> After every step the ranks agree, in one small reduction, on three flags: an unhealthy particle
+!> somewhere, a termination signal received somewhere, and (rank 0's clock) a wall-time checkpoint
+!> being due. All ranks therefore take the same branch in the same step.
 module simulation
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-   use kinds, only: rp
-   use mpi_f08, only: MPI_Comm_rank
+   use kinds, only: rp, i8, name_len
+   use mpi_f08, only: MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER, MPI_MAX
    use error_status, only: status_t
    use mpm_solver, only: solver_t
    use run_diagnostics, only: diagnostics_t, diagnostics_header, diagnostics_row
-   use csv_writer, only: csv_writer_t
+   use csv_writer, only: csv_writer_t, keep_rows_until
    use progress_reporter, only: progress_reporter_t
-   use status_broadcast, only: broadcast_status
+   use status_broadcast, only: broadcast_status, agree_on_status
+   use health_check, only: particles_healthy, describe_unhealthy_particle
+   use termination_signals, only: install_termination_handlers, received_termination_signal, signal_name
+   use run_progress, only: run_progress_t
+   use xdmf_writer, only: output_entry_t, write_particles_xdmf, write_grid_xdmf
+   use field_output, only: write_fields, particle_xdmf_attributes, grid_xdmf_attributes
+   use checkpoint, only: write_checkpoint
+   use output_layout, only: particles_xdmf, grid_xdmf, fields_file
+   use output_directory, only: run_marker
+   use input_text, only: int_text, real_text
    implicit none
    private
 
-   public :: run_simulation
+   public :: run_simulation, blow_up_speed
+
+   !> The default speed limit is this multiple of the fastest wave speed of the materials.
+   real(rp), parameter :: speed_limit_factor = 10.0_rp
+
+   !> Positions of the flags agreed on after every step.
+   integer, parameter :: flag_unhealthy = 1, flag_signal = 2, flag_wall_checkpoint = 3
 
 contains
 
-   !> Run `solver` to its end time (or max_steps), writing diagnostics.csv in the output folder.
-   !> Collective. On return `status` is identical on every rank.
-   subroutine run_simulation(solver, status)
+   !> Run `solver` to its end time (or max_steps), writing into the output folder. `progress` is the
+   !> default for a new run, or what read_checkpoint restored. On return `stopped_by` is 0 if the run
+   !> reached its end, else the signal that stopped it (a checkpoint was written). Collective; on return
+   !> `status` is identical on every rank.
+   subroutine run_simulation(solver, progress, status, stopped_by)
       type(solver_t), intent(inout) :: solver
+      type(run_progress_t), intent(inout) :: progress
       type(status_t), intent(inout) :: status
+      integer, intent(out) :: stopped_by
       type(csv_writer_t) :: csv
-      type(progress_reporter_t) :: progress
+      type(progress_reporter_t) :: reporter
       type(diagnostics_t) :: diag
-      real(rp) :: next_output, end_time, interval
-      integer :: rank
+      character(len=:), allocatable :: dir, checkpoint_path
+      real(rp) :: end_time, interval, speed_limit, last_checkpoint_wall
+      integer :: flags(3)
+      integer(i8) :: last_checkpoint_step
+      logical :: at_output, checkpoint_due
 
-      call MPI_Comm_rank(solver%domain%comm, rank)
+      stopped_by = 0
+      dir = trim(solver%run%output_dir)
       end_time = solver%run%end_time
       interval = solver%run%output_interval
-      if (rank == 0) call csv%open(trim(solver%run%output_dir)//'/diagnostics.csv', diagnostics_header(), status)
-      call broadcast_status(status, solver%domain%comm, 0)
+      speed_limit = blow_up_speed(solver)
+      call open_diagnostics(solver, progress, csv, status)
       if (.not. status%ok) return
 
       diag = solver%diagnostics()
-      if (rank == 0) call csv%write_row(diagnostics_row(diag))
-      call progress%start(solver%run%progress_interval, solver%time, end_time)
-      next_output = min(solver%time + interval, end_time)
+      if (progress%restarted) then
+         call write_xdmf(solver, progress, status)
+      else
+         if (solver%domain%rank == 0) call csv%write_row(diagnostics_row(diag))
+         call write_output(solver, progress, status)
+         progress%next_output_time = min(solver%time + interval, end_time)
+      end if
+      call agree_on_status(status, solver%domain%comm)
+      if (.not. status%ok) then
+         call csv%close()
+         return
+      end if
+      call install_termination_handlers()
+      call reporter%start(solver%run%progress_interval, solver%time, end_time)
+      last_checkpoint_wall = reporter%elapsed()
+      last_checkpoint_step = solver%step
 
       do while (solver%time < end_time * (1.0_rp - 1.0e-12_rp) .and. solver%step < solver%run%max_steps)
          ! land exactly on the next output time
-         if (solver%time + solver%dt * (1.0_rp + 1.0e-9_rp) >= next_output) solver%dt = next_output - solver%time
+         if (solver%time + solver%dt * (1.0_rp + 1.0e-9_rp) >= progress%next_output_time) &
+            solver%dt = progress%next_output_time - solver%time
          call solver%advance()
-         call progress%update(solver%time, solver%step, diag%particles, rank == 0)
-         if (solver%time >= next_output * (1.0_rp - 1.0e-12_rp) .or. solver%step >= solver%run%max_steps) then
+         call reporter%update(solver%time, solver%step, diag%particles, solver%domain%rank == 0)
+
+         flags = 0
+         if (.not. particles_healthy(solver%particles, speed_limit)) flags(flag_unhealthy) = 1
+         flags(flag_signal) = received_termination_signal()
+         if (solver%domain%rank == 0 .and. solver%run%checkpoint_interval_wall > 0.0_rp) then
+            if (reporter%elapsed() - last_checkpoint_wall >= solver%run%checkpoint_interval_wall) &
+               flags(flag_wall_checkpoint) = 1
+         end if
+         call MPI_Allreduce(MPI_IN_PLACE, flags, size(flags), MPI_INTEGER, MPI_MAX, solver%domain%comm)
+
+         if (flags(flag_unhealthy) > 0) then
+            call report_blow_up(solver, progress, speed_limit, status)
+            exit
+         end if
+
+         at_output = solver%time >= progress%next_output_time * (1.0_rp - 1.0e-12_rp) .or. &
+                     solver%step >= solver%run%max_steps
+         if (at_output) then
             diag = solver%diagnostics()
-            if (rank == 0) call csv%write_row(diagnostics_row(diag))
-            if (.not. (ieee_is_finite(diag%kinetic_energy) .and. ieee_is_finite(diag%fluid_volume))) then
-               call status%fail('the solution is no longer finite at step '//int_text(solver%step))
-               exit
-            end if
-            next_output = min(next_output + interval, end_time)
+            if (solver%domain%rank == 0) call csv%write_row(diagnostics_row(diag))
+            call write_output(solver, progress, status)
+            if (.not. status%ok) exit
+            progress%next_output_time = min(progress%next_output_time + interval, end_time)
+         end if
+
+         checkpoint_due = flags(flag_signal) > 0 .or. flags(flag_wall_checkpoint) > 0
+         if (solver%run%checkpoint_interval_steps > 0) &
+            checkpoint_due = checkpoint_due .or. mod(solver%step, solver%run%checkpoint_interval_steps) == 0
+         if (checkpoint_due) then
+            call write_checkpoint(solver, progress, dir, solver%run%checkpoints_kept, checkpoint_path, status)
+            if (.not. status%ok) exit
+            last_checkpoint_wall = reporter%elapsed()
+            last_checkpoint_step = solver%step
+         end if
+         if (flags(flag_signal) > 0) then
+            stopped_by = flags(flag_signal)
+            call status%fail('stopped by '//signal_name(stopped_by)//' at step '//int_text(solver%step)//' (t = '// &
+                             real_text(solver%time)//' s); checkpoint written: '//checkpoint_path// &
+                             '; continue with --restart '//checkpoint_path)
+            exit
          end if
       end do
-      if (rank == 0) call csv%close()
+
+      ! the final state, unless the loop just saved it (or failed)
+      if (status%ok .and. last_checkpoint_step /= solver%step) &
+         call write_checkpoint(solver, progress, dir, solver%run%checkpoints_kept, checkpoint_path, status)
+      call csv%close()
    end subroutine run_simulation
 
-   pure function int_text(i) result(text)
-      use kinds, only: i8
-      integer(i8), intent(in) :: i
-      character(len=:), allocatable :: text
-      character(len=24) :: buffer
-      write (buffer, '(i0)') i
-      text = trim(buffer)
-   end function int_text
+   !> The particle speed taken as a blow-up [m/s]: &run speed_limit, or by default 10 times the fastest
+   !> wave speed of the materials at their reference density (no physical flow of the scene comes near
+   !> it; a numerical instability passes it within a few steps of starting to grow). [R]
+   real(rp) function blow_up_speed(solver) result(speed)
+      type(solver_t), intent(in) :: solver
+      integer :: m
+      speed = solver%run%speed_limit
+      if (speed > 0.0_rp) return
+      do m = 1, size(solver%materials)
+         associate (model => solver%materials(m)%model)
+            speed = max(speed, speed_limit_factor * model%wave_speed(model%reference_density))
+         end associate
+      end do
+   end function blow_up_speed
+
+   !> Rank 0 opens diagnostics.csv: new with its header, or for a restart cut back to the rows up to the
+   !> checkpoint's step and continued. Collective (the status is broadcast).
+   subroutine open_diagnostics(solver, progress, csv, status)
+      type(solver_t), intent(in) :: solver
+      type(run_progress_t), intent(in) :: progress
+      type(csv_writer_t), intent(inout) :: csv
+      type(status_t), intent(inout) :: status
+      character(len=:), allocatable :: path
+      path = trim(solver%run%output_dir)//'/'//run_marker
+      if (solver%domain%rank == 0) then
+         if (progress%restarted) then
+            call keep_rows_until(path, 2, progress%restart_step, status)       ! column 2: step
+            if (status%ok) call csv%open(path, diagnostics_header(), status, append=.true.)
+         else
+            call csv%open(path, diagnostics_header(), status)
+         end if
+      end if
+      call broadcast_status(status, solver%domain%comm, 0)
+   end subroutine open_diagnostics
+
+   !> The fields file of the next output number and the XDMF files listing it. Collective.
+   subroutine write_output(solver, progress, status)
+      type(solver_t), intent(inout) :: solver
+      type(run_progress_t), intent(inout) :: progress
+      type(status_t), intent(inout) :: status
+      type(output_entry_t) :: entry
+      if (.not. status%ok) return
+      if (.not. (solver%run%particle_output .or. solver%run%grid_output)) return
+      call write_fields(solver, trim(solver%run%output_dir), progress%output_count(), entry, status)
+      if (.not. status%ok) return
+      call progress%add_output(entry)
+      call write_xdmf(solver, progress, status)
+   end subroutine write_output
+
+   !> Rank 0 rewrites particles.xmf and grid.xmf for the outputs so far. Collective (status broadcast).
+   subroutine write_xdmf(solver, progress, status)
+      type(solver_t), intent(in) :: solver
+      type(run_progress_t), intent(in) :: progress
+      type(status_t), intent(inout) :: status
+      character(len=:), allocatable :: dir
+      integer :: n
+      dir = trim(solver%run%output_dir)
+      n = progress%output_count()
+      if (solver%domain%rank == 0 .and. n > 0) then
+         if (solver%run%particle_output) call write_particles_xdmf(dir//'/'//particles_xdmf, progress%outputs(1:n), &
+                                                                   particle_xdmf_attributes(), status)
+         if (solver%run%grid_output) call write_grid_xdmf(dir//'/'//grid_xdmf, progress%outputs(1:n), &
+                                                          grid_xdmf_attributes(solver), solver%grid%dim, &
+                                                          solver%grid%h, status)
+      end if
+      call broadcast_status(status, solver%domain%comm, 0)
+   end subroutine write_xdmf
+
+   !> Some rank holds an unhealthy particle: name the lowest such rank's first one, write the state as
+   !> a last output for inspection, and fail. Collective.
+   subroutine report_blow_up(solver, progress, speed_limit, status)
+      type(solver_t), intent(inout) :: solver
+      type(run_progress_t), intent(inout) :: progress
+      real(rp), intent(in) :: speed_limit
+      type(status_t), intent(inout) :: status
+      type(status_t) :: output_status
+      character(len=:), allocatable :: description, inspection
+      character(len=name_len) :: names(size(solver%materials))
+      integer :: particle, m
+      do m = 1, size(solver%materials)
+         names(m) = solver%materials(m)%model%name
+      end do
+      call describe_unhealthy_particle(solver%particles, speed_limit, names, particle, description)
+      if (particle > 0) call status%fail('the solution blew up at step '//int_text(solver%step)//' (t = '// &
+                                         real_text(solver%time)//' s) on rank '//int_text(solver%domain%rank)//': '// &
+                                         description)
+      call agree_on_status(status, solver%domain%comm)
+      inspection = fields_file(progress%output_count())
+      call write_output(solver, progress, output_status)
+      if (output_status%ok) then
+         if (solver%run%particle_output .or. solver%run%grid_output) &
+            status%message = trim(status%message)//'; the state was written to '//trim(solver%run%output_dir)// &
+                             '/'//inspection//' for inspection'
+      else
+         status%message = trim(status%message)//'; writing the state for inspection failed: '//trim(output_status%message)
+      end if
+   end subroutine report_blow_up
 end module simulation

@@ -13,6 +13,15 @@ module stabilizer
    implicit none
    private
 
+   !> What a stage works on besides the particles: the slice first:last of its material's particles, the
+   !> decomposition (halo exchanges), the grid and dt.
+   type, public :: stage_context_t
+      integer :: first = 1, last = 0
+      type(domain_t), pointer :: domain => null()
+      type(grid_t), pointer :: grid => null()
+      real(rp) :: dt = 0.0_rp
+   end type stage_context_t
+
    type, abstract, public :: stabilizer_t
       integer :: material = 0     !< material index whose particles this scheme filters
    contains
@@ -22,13 +31,11 @@ module stabilizer
    end type stabilizer_t
 
    abstract interface
-      subroutine stage_interface(self, domain, grid, particles, dt)
-         import :: stabilizer_t, domain_t, grid_t, particle_set_t, rp
+      subroutine stage_interface(self, context, particles)
+         import :: stabilizer_t, stage_context_t, particle_set_t
          class(stabilizer_t), intent(inout) :: self
-         type(domain_t), intent(in) :: domain
-         type(grid_t), intent(in) :: grid
+         type(stage_context_t), intent(in) :: context
          type(particle_set_t), intent(inout) :: particles
-         real(rp), intent(in) :: dt
       end subroutine stage_interface
    end interface
 

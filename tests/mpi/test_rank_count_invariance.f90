@@ -16,7 +16,7 @@ module test_rank_count_invariance
    implicit none
    private
 
-   public :: test_hydrostatic_tank_rank_invariance, test_settling_tank_rank_invariance, &
+   public :: test_hydrostatic_tank_rank_invariance, test_settling_tank_rank_invariance, test_schemes_rank_invariance, &
              test_collapsing_column_rank_invariance, test_collapsing_column_3d_rank_invariance
 
    integer, parameter :: n_steps = 200
@@ -43,6 +43,25 @@ contains
       call compare_rank_counts(comm, scene)
    end subroutine test_settling_tank_rank_invariance
 
+   !> The settling tank and the collapsing column with each stabilization scheme (C0, NB, FOAL1).
+   subroutine test_schemes_rank_invariance(comm)
+      type(MPI_Comm), intent(in) :: comm
+      character(len=5), parameter :: schemes(3) = [character(len=5) :: 'C0', 'NB', 'FOAL1']
+      type(scene_t) :: scene
+      integer :: i
+      do i = 1, size(schemes)
+         scene = water_scene(2, 0.4_rp, [3.2_rp, 6.4_rp, 0.0_rp], 2.0e7_rp, 10.0_rp)
+         call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [3.2_rp, 3.2_rp, 0.0_rp], 3, .false., 0.0_rp)
+         scene%materials(1)%stabilization = schemes(i)
+         call compare_rank_counts(comm, scene, label='settling tank, '//trim(schemes(i)))
+         scene = water_scene(2, 0.05_rp, [4.0_rp, 2.0_rp, 0.0_rp], 2.0e6_rp, 9.81_rp)
+         call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [1.0_rp, 1.0_rp, 0.0_rp], 2, .false., 0.0_rp)
+         scene%run%fixed_dt = 5.0e-4_rp
+         scene%materials(1)%stabilization = schemes(i)
+         call compare_rank_counts(comm, scene, label='collapsing column, '//trim(schemes(i)))
+      end do
+   end subroutine test_schemes_rank_invariance
+
    !> A water column collapsing in a 4 m x 2 m box (dam break), particles crossing rank boundaries.
    subroutine test_collapsing_column_rank_invariance(comm)
       type(MPI_Comm), intent(in) :: comm
@@ -64,10 +83,12 @@ contains
 
    !> Run on a one-rank communicator (rank 0 alone) and on `comm`; compare. Optional scales replace
    !> the serial value as the reference of the relative tolerance when they are larger.
-   subroutine compare_rank_counts(comm, scene, energy_scale, speed_scale)
+   subroutine compare_rank_counts(comm, scene, energy_scale, speed_scale, label)
       type(MPI_Comm), intent(in) :: comm
       type(scene_t), intent(in) :: scene
       real(rp), intent(in), optional :: energy_scale, speed_scale
+      character(len=*), intent(in), optional :: label
+      character(len=:), allocatable :: what
       type(MPI_Comm) :: serial
       type(diagnostics_t) :: one, all
       real(rp) :: serial_values(6)
@@ -84,20 +105,22 @@ contains
       end if
       call MPI_Bcast(serial_values, 6, MPI_DOUBLE_PRECISION, 0, comm)
       all = run_steps(comm, scene)
-      call assertRelativelyEqual(serial_values(1), all%time, 1.0e-12_rp, 'time')
-      call assertRelativelyEqual(serial_values(2), all%total_mass, 1.0e-12_rp, 'total mass')
+      what = ''
+      if (present(label)) what = ' ('//label//')'
+      call assertRelativelyEqual(serial_values(1), all%time, 1.0e-12_rp, 'time'//what)
+      call assertRelativelyEqual(serial_values(2), all%total_mass, 1.0e-12_rp, 'total mass'//what)
       if (present(energy_scale)) then
          call assertEqual(serial_values(3), all%kinetic_energy, 1.0e-10_rp * max(energy_scale, abs(serial_values(3))), &
-                          'kinetic energy (against m g H)')
+                          'kinetic energy (against m g H)'//what)
          call assertEqual(serial_values(6), all%max_speed, 1.0e-10_rp * max(speed_scale, abs(serial_values(6))), &
-                          'max speed (against sqrt(g H))')
+                          'max speed (against sqrt(g H))'//what)
       else
-         call assertRelativelyEqual(serial_values(3), all%kinetic_energy, 1.0e-10_rp, 'kinetic energy')
-         call assertRelativelyEqual(serial_values(6), all%max_speed, 1.0e-10_rp, 'max speed')
+         call assertRelativelyEqual(serial_values(3), all%kinetic_energy, 1.0e-10_rp, 'kinetic energy'//what)
+         call assertRelativelyEqual(serial_values(6), all%max_speed, 1.0e-10_rp, 'max speed'//what)
          call assertTrue(all%kinetic_energy > 0.0_rp, 'the scene moved')
       end if
-      call assertRelativelyEqual(serial_values(4), all%fluid_volume, 1.0e-10_rp, 'fluid volume')
-      call assertRelativelyEqual(serial_values(5), all%h_eq, 1.0e-10_rp, 'h_eq')
+      call assertRelativelyEqual(serial_values(4), all%fluid_volume, 1.0e-10_rp, 'fluid volume'//what)
+      call assertRelativelyEqual(serial_values(5), all%h_eq, 1.0e-10_rp, 'h_eq'//what)
    end subroutine compare_rank_counts
 
    function run_steps(comm, scene) result(diag)

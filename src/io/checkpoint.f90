@@ -1,0 +1,415 @@
+!> Checkpoints: the full state a run needs to continue, in one HDF5 file written by all ranks
+!> (docs/output.md, "Checkpoints and restart").
+!>
+!> Saved: every particle's persistent state (position, velocity, mass, density, sbar, material, id) in
+!> each rank's order, the rank each slab came from, time, step, the next dt, the per-rank counters
+!> (lost particles, wall corrections), the empty-node mass tolerance, and the run's progress (next
+!> output time, the outputs written so far, the checkpoint number). Restarting on the same number of
+!> ranks restores every rank's particles in their order, so the continued run is bitwise identical to
+!> an uninterrupted one; on another number of ranks the particles are redistributed by position and
+!> re-sorted (equal to round-off).
+!>
+!> A checkpoint is written as `<name>.tmp`, synced to disk, and renamed only when complete; it carries
+!> a format name and version, and an attribute `complete` written last. Reading checks all of these
+!> and the scene's grid and materials, and reads everything before it changes the solver: a bad file
+!> is refused as a whole.
+module checkpoint
+   use kinds, only: rp, i8, path_len
+   use mpi_f08, only: MPI_Comm_size
+   use error_status, only: status_t
+   use scene_description, only: scene_t
+   use mpm_solver, only: solver_t
+   use particle_sorting, only: update_cells, sort_by_material_and_cell
+   use particle_redistribution, only: redistribute_particles
+   use hdf5_file, only: hdf5_file_t, slab_t, distributed_slab, even_slab
+   use xdmf_writer, only: output_entry_t
+   use run_progress, only: run_progress_t
+   use output_layout, only: checkpoint_folder, checkpoint_file, latest_checkpoint, temporary_suffix
+   use file_system, only: rename_path, remove_file, path_exists
+   use status_broadcast, only: agree_on_status, broadcast_status
+   use input_text, only: int_text
+   implicit none
+   private
+
+   !> Identification of the file format; a reader accepts exactly this version.
+   character(len=*), parameter, public :: checkpoint_format = 'flotsam checkpoint'
+   integer, parameter, public :: checkpoint_format_version = 1
+
+   public :: write_checkpoint, read_checkpoint, latest_checkpoint_path
+
+contains
+
+   !> Write checkpoint number progress%checkpoints_written + 1 of the solver's state into `dir`, make it
+   !> the latest, and remove the ones older than the newest `kept`. `path` returns its name. Collective.
+   subroutine write_checkpoint(solver, progress, dir, kept, path, status)
+      type(solver_t), intent(in) :: solver
+      type(run_progress_t), intent(inout) :: progress
+      character(len=*), intent(in) :: dir
+      integer, intent(in) :: kept
+      character(len=:), allocatable, intent(out) :: path
+      type(status_t), intent(inout) :: status
+      type(hdf5_file_t) :: file
+      integer :: sequence, m
+
+      sequence = progress%checkpoints_written + 1
+      path = trim(dir)//'/'//checkpoint_file(sequence)
+      call file%create(path//temporary_suffix, solver%domain%comm, status)
+      call file%write_attribute('format', checkpoint_format, status)
+      call file%write_attribute('format_version', checkpoint_format_version, status)
+      call file%write_attribute('sequence', sequence, status)
+      call file%write_attribute('ranks', solver%domain%nranks, status)
+      call file%write_attribute('dim', solver%grid%dim, status)
+      call file%write_attribute('cells', solver%grid%global_cells, status)
+      call file%write_attribute('origin', solver%grid%origin, status)
+      call file%write_attribute('cell_size', solver%grid%h, status)
+      call file%write_attribute('materials', size(solver%materials), status)
+      do m = 1, size(solver%materials)
+         call file%write_attribute('material_'//int_text(m), solver%materials(m)%model%name, status)
+      end do
+      call file%write_attribute('time', solver%time, status)
+      call file%write_attribute('step', solver%step, status)
+      call file%write_attribute('dt', solver%dt, status)
+      call file%write_attribute('mass_tolerance', solver%mass_tolerance, status)
+      call file%write_attribute('next_output_time', progress%next_output_time, status)
+      call write_particles(solver, file, status)
+      call write_outputs(solver, progress, file, status)
+      ! last: a file without it was not finished (cannot happen after the rename, but costs nothing)
+      call file%write_attribute('complete', 1, status)
+      call file%close(status, flush=.true.)
+      call agree_on_status(status, solver%domain%comm)
+      if (.not. status%ok) return
+
+      if (solver%domain%rank == 0) call publish(dir, path, sequence, kept, status)
+      call broadcast_status(status, solver%domain%comm, 0)
+      if (status%ok) progress%checkpoints_written = sequence
+   end subroutine write_checkpoint
+
+   !> Rank 0: rename the finished file, point `latest` at it, remove checkpoints older than `kept`.
+   subroutine publish(dir, path, sequence, kept, status)
+      character(len=*), intent(in) :: dir, path
+      integer, intent(in) :: sequence, kept
+      type(status_t), intent(inout) :: status
+      character(len=:), allocatable :: pointer_path, old
+      integer :: unit, ios, s
+      if (.not. rename_path(path//temporary_suffix, path)) then
+         call status%fail('cannot rename '//path//temporary_suffix//' to '//path)
+         return
+      end if
+      pointer_path = trim(dir)//'/'//checkpoint_folder//'/'//latest_checkpoint
+      open (newunit=unit, file=pointer_path//temporary_suffix, status='replace', action='write', iostat=ios)
+      if (ios == 0) write (unit, '(a)', iostat=ios) checkpoint_name(path)
+      if (ios == 0) close (unit, iostat=ios)
+      if (ios == 0) then
+         if (.not. rename_path(pointer_path//temporary_suffix, pointer_path)) ios = 1
+      end if
+      if (ios /= 0) then
+         call status%fail('cannot write '//pointer_path)
+         return
+      end if
+      ! older ones form a contiguous run of numbers below sequence - kept + 1
+      do s = sequence - kept, 1, -1
+         old = trim(dir)//'/'//checkpoint_file(s)
+         if (.not. path_exists(old)) exit
+         if (.not. remove_file(old)) exit
+      end do
+   end subroutine publish
+
+   !> The file name of a checkpoint path (what `latest` holds).
+   pure function checkpoint_name(path) result(name)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: name
+      name = path(index(path, '/', back=.true.) + 1:)
+   end function checkpoint_name
+
+   !> The checkpoint that `dir`/checkpoints/latest names ('' with a failed status if there is none).
+   !> Called by one rank.
+   function latest_checkpoint_path(dir, status) result(path)
+      character(len=*), intent(in) :: dir
+      type(status_t), intent(inout) :: status
+      character(len=:), allocatable :: path
+      character(len=path_len) :: name
+      character(len=:), allocatable :: pointer_path
+      integer :: unit, ios
+      path = ''
+      pointer_path = trim(dir)//'/'//checkpoint_folder//'/'//latest_checkpoint
+      open (newunit=unit, file=pointer_path, status='old', action='read', iostat=ios)
+      if (ios == 0) read (unit, '(a)', iostat=ios) name
+      if (ios == 0) close (unit)
+      if (ios /= 0) then
+         call status%fail('--restart latest: no checkpoint recorded in '//pointer_path)
+         return
+      end if
+      path = trim(dir)//'/'//checkpoint_folder//'/'//trim(name)
+   end function latest_checkpoint_path
+
+   !> /particles in each rank's order and /ranks: the slab sizes and counters of every rank.
+   subroutine write_particles(solver, file, status)
+      type(solver_t), intent(in) :: solver
+      type(hdf5_file_t), intent(inout) :: file
+      type(status_t), intent(inout) :: status
+      type(slab_t) :: slab, one
+      integer :: n
+      real(rp), allocatable :: vectors(:, :), reals(:, :), scalars(:)
+      integer, allocatable :: integers(:)
+      integer(i8), allocatable :: ids(:)
+
+      n = solver%particles%count
+      slab = distributed_slab(solver%domain%comm, n)
+      call file%write_attribute('particles', slab%total, status)
+      call file%create_group('particles', status)
+      associate (particles => solver%particles)
+         allocate (vectors(particles%dim, max(n, 1)), reals(particles%n_sigma, max(n, 1)), scalars(max(n, 1)), &
+                   integers(max(n, 1)), ids(max(n, 1)))
+         vectors(:, 1:n) = particles%x(:, 1:n)
+         call file%write_slab('particles/x', slab, vectors, status)
+         vectors(:, 1:n) = particles%v(:, 1:n)
+         call file%write_slab('particles/v', slab, vectors, status)
+         scalars(1:n) = particles%mass(1:n)
+         call file%write_slab('particles/mass', slab, scalars, status)
+         scalars(1:n) = particles%density(1:n)
+         call file%write_slab('particles/density', slab, scalars, status)
+         reals(:, 1:n) = particles%sbar(:, 1:n)
+         call file%write_slab('particles/sbar', slab, reals, status)
+         integers(1:n) = particles%material(1:n)
+         call file%write_slab('particles/material', slab, integers, status)
+         ids(1:n) = particles%id(1:n)
+         call file%write_slab('particles/id', slab, ids, status)
+      end associate
+      one = distributed_slab(solver%domain%comm, 1)
+      call file%create_group('ranks', status)
+      call file%write_slab('ranks/particles', one, [int(n, i8)], status)
+      call file%write_slab('ranks/lost_particles', one, [int(solver%lost_particles, i8)], status)
+      call file%write_slab('ranks/wall_corrections', one, [int(solver%wall_corrections, i8)], status)
+   end subroutine write_particles
+
+   !> /outputs: what every output so far wrote (rank 0 holds the list).
+   subroutine write_outputs(solver, progress, file, status)
+      type(solver_t), intent(in) :: solver
+      type(run_progress_t), intent(in) :: progress
+      type(hdf5_file_t), intent(inout) :: file
+      type(status_t), intent(inout) :: status
+      type(slab_t) :: slab
+      integer :: n, e
+      real(rp), allocatable :: reals(:, :)
+      integer(i8), allocatable :: integers(:, :)
+      n = progress%output_count()
+      if (solver%domain%rank /= 0) n = 0
+      slab = distributed_slab(solver%domain%comm, n)
+      allocate (reals(4, max(n, 1)), integers(6, max(n, 1)))
+      do e = 1, n
+         associate (entry => progress%outputs(e))
+            reals(:, e) = [entry%time, entry%grid_origin]
+            integers(:, e) = [int(entry%index, i8), entry%step, entry%particles, int(entry%grid_cells, i8)]
+         end associate
+      end do
+      call file%create_group('outputs', status)
+      call file%write_slab('outputs/time_and_grid_origin', slab, reals, status)
+      ! integers as reals: exact below 2**53
+      call file%write_slab('outputs/index_step_particles_grid_cells', slab, real(integers, rp), status)
+   end subroutine write_outputs
+
+   !> Restore the solver's state and the run's progress from checkpoint `path` for `scene`. The solver
+   !> must be set up for the scene without particles (solver%init(..., seed_particles=.false.)).
+   !> Nothing is changed unless the whole file was read and accepted. Collective.
+   subroutine read_checkpoint(path, scene, solver, progress, status)
+      character(len=*), intent(in) :: path
+      type(scene_t), intent(in) :: scene
+      type(solver_t), intent(inout) :: solver
+      type(run_progress_t), intent(out) :: progress
+      type(status_t), intent(inout) :: status
+      type(hdf5_file_t) :: file
+      type(slab_t) :: slab, all_ranks
+      character(len=64) :: text
+      integer :: version, complete, ranks_written, n, rank, n_ranks, p
+      integer(i8) :: total, step
+      integer(i8), allocatable :: rank_counts(:), lost(:), corrections(:)
+      real(rp) :: time, dt, mass_tolerance, next_output_time
+      real(rp), allocatable :: x(:, :), v(:, :), mass(:), density(:), sbar(:, :)
+      integer, allocatable :: material(:)
+      integer(i8), allocatable :: id(:)
+      character(len=:), allocatable :: where
+
+      where = 'checkpoint '//trim(path)
+      call file%open(path, solver%domain%comm, status)
+      if (.not. status%ok) then
+         call status%reset()
+         call status%fail('cannot open '//where//': missing, truncated or not an HDF5 file')
+         return
+      end if
+      text = ''
+      version = -1
+      complete = 0
+      call file%read_attribute('format', text, status)
+      if (status%ok .and. text /= checkpoint_format) call status%fail(where//' is not a Flotsam checkpoint')
+      call file%read_attribute('format_version', version, status)
+      if (status%ok .and. version /= checkpoint_format_version) then
+         call status%fail(where//' has format version '//int_text(version)//'; this build of flotsam reads version '// &
+                          int_text(checkpoint_format_version))
+      end if
+      call file%read_attribute('complete', complete, status)
+      if (status%ok .and. complete /= 1) call status%fail(where//' is incomplete')
+      call check_scene(file, scene, where, status)
+
+      time = 0.0_rp
+      dt = 0.0_rp
+      mass_tolerance = 0.0_rp
+      next_output_time = 0.0_rp
+      step = 0
+      total = 0
+      ranks_written = 1
+      call file%read_attribute('time', time, status)
+      call file%read_attribute('step', step, status)
+      call file%read_attribute('dt', dt, status)
+      call file%read_attribute('mass_tolerance', mass_tolerance, status)
+      call file%read_attribute('next_output_time', next_output_time, status)
+      call file%read_attribute('sequence', progress%checkpoints_written, status)
+      call file%read_attribute('ranks', ranks_written, status)
+      call file%read_attribute('particles', total, status)
+      if (status%ok .and. (ranks_written < 1 .or. total < 0)) call status%fail(where//' has invalid counts')
+      if (.not. status%ok) then
+         call file%close(status)
+         return
+      end if
+
+      ! which particles this rank reads: its own slab on the same number of ranks, an even share otherwise
+      rank = solver%domain%rank
+      call MPI_Comm_size(solver%domain%comm, n_ranks)
+      allocate (rank_counts(ranks_written), lost(ranks_written), corrections(ranks_written))
+      all_ranks = slab_t(0, ranks_written, ranks_written)
+      call file%read_slab('ranks/particles', all_ranks, rank_counts, status)
+      call file%read_slab('ranks/lost_particles', all_ranks, lost, status)
+      call file%read_slab('ranks/wall_corrections', all_ranks, corrections, status)
+      if (status%ok .and. sum(rank_counts) /= total) call status%fail(where//' has inconsistent particle counts')
+      if (.not. status%ok) then
+         call file%close(status)
+         return
+      end if
+      if (ranks_written == n_ranks) then
+         slab = slab_t(sum(rank_counts(1:rank)), rank_counts(rank + 1), total)
+      else
+         slab = even_slab(total, rank, n_ranks)
+      end if
+      n = int(slab%count)
+      allocate (x(scene%grid%dim, max(n, 1)), v(scene%grid%dim, max(n, 1)), mass(max(n, 1)), density(max(n, 1)), &
+                sbar(solver%particles%n_sigma, max(n, 1)), material(max(n, 1)), id(max(n, 1)))
+      call file%read_slab('particles/x', slab, x, status)
+      call file%read_slab('particles/v', slab, v, status)
+      call file%read_slab('particles/mass', slab, mass, status)
+      call file%read_slab('particles/density', slab, density, status)
+      call file%read_slab('particles/sbar', slab, sbar, status)
+      call file%read_slab('particles/material', slab, material, status)
+      call file%read_slab('particles/id', slab, id, status)
+      call read_outputs(file, progress, status)
+      if (status%ok .and. n > 0) then
+         if (any(material(1:n) < 1 .or. material(1:n) > size(solver%materials))) &
+            call status%fail(where//' holds a particle of an unknown material')
+      end if
+      call file%close(status)
+      call agree_on_status(status, solver%domain%comm)
+      if (.not. status%ok) return
+
+      ! accepted: adopt the state
+      call solver%particles%init(scene%grid%dim, size(scene%materials), max(n, 1024))
+      do p = 1, n
+         call solver%particles%add(x(:, p), v(:, p), mass(p), density(p), sbar(:, p), material(p), id(p))
+      end do
+      solver%time = time
+      solver%step = step
+      solver%dt = dt
+      solver%mass_tolerance = mass_tolerance
+      if (ranks_written == n_ranks) then
+         solver%lost_particles = int(lost(rank + 1))
+         solver%wall_corrections = int(corrections(rank + 1))
+         ! keep each rank's order: the continued run is then bitwise identical to an uninterrupted one
+         if (any([(solver%grid%owned_local_cell(x(:, p)) == 0, p = 1, n)])) &
+            call status%fail(where//': a particle lies outside the cells of the rank that wrote it')
+         call agree_on_status(status, solver%domain%comm)
+         if (.not. status%ok) return
+         call update_cells(solver%grid, solver%particles)
+      else
+         solver%lost_particles = merge(int(sum(lost)), 0, rank == 0)
+         solver%wall_corrections = merge(int(sum(corrections)), 0, rank == 0)
+         call redistribute_particles(solver%domain, solver%grid, solver%particles, status)
+         if (.not. status%ok) return
+         call update_cells(solver%grid, solver%particles)
+         call sort_by_material_and_cell(solver%grid, solver%particles)
+      end if
+      progress%next_output_time = next_output_time
+      progress%restarted = .true.
+      progress%restart_step = step
+   end subroutine read_checkpoint
+
+   !> The checkpoint must come from a scene with the same grid and materials.
+   subroutine check_scene(file, scene, where, status)
+      type(hdf5_file_t), intent(in) :: file
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: where
+      type(status_t), intent(inout) :: status
+      integer :: dim, cells(3), n_materials, m
+      real(rp) :: origin(3), cell_size
+      character(len=64) :: name
+      real(rp), parameter :: same = 1.0e-12_rp     ! relative to the cell size: round-off only
+      dim = 0
+      cells = 0
+      origin = 0.0_rp
+      cell_size = 0.0_rp
+      n_materials = 0
+      call file%read_attribute('dim', dim, status)
+      call file%read_attribute('cells', cells, status)
+      call file%read_attribute('origin', origin, status)
+      call file%read_attribute('cell_size', cell_size, status)
+      call file%read_attribute('materials', n_materials, status)
+      if (.not. status%ok) return
+      if (dim /= scene%grid%dim) then
+         call status%fail(where//' was written for a '//int_text(dim)//'-D scene, this scene is '// &
+                          int_text(scene%grid%dim)//'-D')
+      else if (any(cells /= scene%grid%ncells) .or. any(abs(origin - scene%grid%origin) > same * cell_size) .or. &
+               abs(cell_size - scene%grid%cell_size) > same * cell_size) then
+         call status%fail(where//' was written for another grid (&grid cell_size, origin or extent differ)')
+      else if (n_materials /= size(scene%materials)) then
+         call status%fail(where//' was written for '//int_text(n_materials)//' materials, the scene has '// &
+                          int_text(size(scene%materials)))
+      end if
+      do m = 1, min(n_materials, size(scene%materials))
+         if (.not. status%ok) return
+         name = ''
+         call file%read_attribute('material_'//int_text(m), name, status)
+         if (status%ok .and. name /= scene%materials(m)%name) then
+            call status%fail(where//": material "//int_text(m)//" is '"//trim(name)//"' there and '"// &
+                             trim(scene%materials(m)%name)//"' in the scene")
+         end if
+      end do
+   end subroutine check_scene
+
+   !> Every rank reads the whole list of outputs.
+   subroutine read_outputs(file, progress, status)
+      type(hdf5_file_t), intent(in) :: file
+      type(run_progress_t), intent(inout) :: progress
+      type(status_t), intent(inout) :: status
+      integer(i8), allocatable :: dims(:)
+      real(rp), allocatable :: reals(:, :), integers(:, :)
+      type(output_entry_t) :: entry
+      type(slab_t) :: slab
+      integer :: e
+      dims = file%dataset_dims('outputs/time_and_grid_origin', status)
+      if (.not. status%ok) return
+      if (size(dims) /= 2) then
+         call status%fail('checkpoint '//file%path//': outputs/time_and_grid_origin has the wrong shape')
+         return
+      end if
+      slab = slab_t(0, dims(2), dims(2))
+      allocate (reals(4, max(1_i8, dims(2))), integers(6, max(1_i8, dims(2))))
+      call file%read_slab('outputs/time_and_grid_origin', slab, reals, status)
+      call file%read_slab('outputs/index_step_particles_grid_cells', slab, integers, status)
+      if (.not. status%ok) return
+      do e = 1, int(dims(2))
+         entry%time = reals(1, e)
+         entry%grid_origin = reals(2:4, e)
+         entry%index = nint(integers(1, e))
+         entry%step = nint(integers(2, e), i8)
+         entry%particles = nint(integers(3, e), i8)
+         entry%grid_cells = nint(integers(4:6, e))
+         call progress%add_output(entry)
+      end do
+   end subroutine read_outputs
+end module checkpoint

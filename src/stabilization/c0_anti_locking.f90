@@ -1,0 +1,94 @@
+!> Cell-based anti-locking C0 of Mast et al. (2012) as used in [Y17] (algorithms.md section 2.2).
+!>
+!> Per material and cell, with masses as weights (the rho-weighted projections of eq. 1):
+!>   d~_c = sum m_p d_p / m_c   -> d_p := d~_c        (before the constitutive update)
+!>   s~_c = sum m_p s_p / m_c   -> s_p := s~_c        (after it; s = sigma / rho, eq. 4)
+!> Full tensors by default [P]. Option volumetric_only [R] (B-bar-like, section 2.5): only the
+!> volumetric rate (tr d shared over the dim in-plane normal components, so d_zz stays 0 in plane
+!> strain) and the mean specific stress are averaged; the particle keeps its deviatoric parts.
+!> The spin is never filtered [R].
+module c0_anti_locking
+   use kinds, only: rp
+   use particle_set, only: particle_set_t
+   use stabilizer, only: stabilizer_t, stage_context_t
+   use cell_binning, only: bin_cell_mass, replace_by_cell_average
+   implicit none
+   private
+
+   type, extends(stabilizer_t), public :: c0_anti_locking_t
+      logical :: volumetric_only = .false.
+      real(rp), allocatable :: cell_mass(:)      !< m_c of the owned cells (this material)
+   contains
+      procedure :: prepare => c0_prepare
+      procedure :: filter_strain_rate => c0_filter_strain_rate
+      procedure :: filter_stress => c0_filter_stress
+   end type c0_anti_locking_t
+
+contains
+
+   !> Cell masses at x^n.
+   subroutine c0_prepare(self, context, particles)
+      class(c0_anti_locking_t), intent(inout) :: self
+      type(stage_context_t), intent(in) :: context
+      type(particle_set_t), intent(inout) :: particles
+      if (.not. allocated(self%cell_mass)) allocate (self%cell_mass(context%grid%cell_count))
+      if (size(self%cell_mass) /= context%grid%cell_count) then
+         deallocate (self%cell_mass)
+         allocate (self%cell_mass(context%grid%cell_count))
+      end if
+      call bin_cell_mass(particles, context%first, context%last, &
+                         self%cell_mass)
+   end subroutine c0_prepare
+
+   !> Filter part A: d_p := d~_c ([Y17] eq. 4, left).
+   subroutine c0_filter_strain_rate(self, context, particles)
+      class(c0_anti_locking_t), intent(inout) :: self
+      type(stage_context_t), intent(in) :: context
+      type(particle_set_t), intent(inout) :: particles
+      integer :: first, last
+      first = context%first
+      last = context%last
+      if (last < first) return
+      if (self%volumetric_only) then
+         call replace_volumetric_part(self, particles, first, last, particles%strain_rate(:, first:last), &
+                                      context%grid%dim)
+      else
+         call replace_by_cell_average(particles, first, last, self%cell_mass, particles%strain_rate(:, first:last))
+      end if
+   end subroutine c0_filter_strain_rate
+
+   !> Filter part B: s_p := s~_c ([Y17] eq. 4, right).
+   subroutine c0_filter_stress(self, context, particles)
+      class(c0_anti_locking_t), intent(inout) :: self
+      type(stage_context_t), intent(in) :: context
+      type(particle_set_t), intent(inout) :: particles
+      integer :: first, last
+      first = context%first
+      last = context%last
+      if (last < first) return
+      if (self%volumetric_only) then
+         call replace_volumetric_part(self, particles, first, last, particles%sbar(:, first:last), 3)
+      else
+         call replace_by_cell_average(particles, first, last, self%cell_mass, particles%sbar(:, first:last))
+      end if
+   end subroutine c0_filter_stress
+
+   !> Replace the mean of the first n_normal normal components by its cell average:
+   !> t_p(k) += (mean_c - mean_p) for k = 1..n_normal.
+   subroutine replace_volumetric_part(self, particles, first, last, tensors, n_normal)
+      type(c0_anti_locking_t), intent(in) :: self
+      type(particle_set_t), intent(in) :: particles
+      integer, intent(in) :: first, last, n_normal
+      real(rp), intent(inout) :: tensors(:, :)
+      real(rp), allocatable :: mean(:, :)
+      integer :: p
+      allocate (mean(1, last - first + 1))
+      do p = 1, last - first + 1
+         mean(1, p) = sum(tensors(1:n_normal, p)) / n_normal
+      end do
+      call replace_by_cell_average(particles, first, last, self%cell_mass, mean)
+      do p = 1, last - first + 1
+         tensors(1:n_normal, p) = tensors(1:n_normal, p) - sum(tensors(1:n_normal, p)) / n_normal + mean(1, p)
+      end do
+   end subroutine replace_volumetric_part
+end module c0_anti_locking

@@ -1,0 +1,76 @@
+!> Mass-weighted cell sums of one material's particles, the building block of C0 and FOAL1
+!> ([Y17] eq. 4): m_c = sum m_p, x_o^c = sum m_p x_p / m_c, q_c = sum m_p q_p / m_c.
+!> Particles are binned by particles%cell, their cell at x^n.
+module cell_binning
+   use kinds, only: rp
+   use particle_set, only: particle_set_t
+   implicit none
+   private
+
+   public :: bin_cell_mass, bin_cell_centre, cell_average, replace_by_cell_average
+
+contains
+
+   !> m_c of the cells holding particles first..last.
+   subroutine bin_cell_mass(particles, first, last, cell_mass)
+      type(particle_set_t), intent(in) :: particles
+      integer, intent(in) :: first, last
+      real(rp), intent(out) :: cell_mass(:)
+      integer :: p
+      cell_mass = 0.0_rp
+      do p = first, last
+         cell_mass(particles%cell(p)) = cell_mass(particles%cell(p)) + particles%mass(p)
+      end do
+   end subroutine bin_cell_mass
+
+   !> Mass centre x_o^c (where m_c > 0) of the particles first..last at their current positions.
+   subroutine bin_cell_centre(particles, first, last, cell_mass, centre)
+      type(particle_set_t), intent(in) :: particles
+      integer, intent(in) :: first, last
+      real(rp), intent(in) :: cell_mass(:)
+      real(rp), intent(out) :: centre(:, :)
+      integer :: p, c
+      centre = 0.0_rp
+      do p = first, last
+         c = particles%cell(p)
+         centre(:, c) = centre(:, c) + particles%mass(p) * particles%x(:, p)
+      end do
+      do c = 1, size(cell_mass)
+         if (cell_mass(c) > 0.0_rp) centre(:, c) = centre(:, c) / cell_mass(c)
+      end do
+   end subroutine bin_cell_centre
+
+   !> average(:, c) = sum m_p values(:, p) / m_c over the particles first..last; values(:, p - first + 1)
+   !> belongs to particle p. Cells without particles get 0.
+   subroutine cell_average(particles, first, last, cell_mass, values, average)
+      type(particle_set_t), intent(in) :: particles
+      integer, intent(in) :: first, last
+      real(rp), intent(in) :: cell_mass(:), values(:, :)
+      real(rp), intent(out) :: average(:, :)
+      integer :: p, c
+      average = 0.0_rp
+      do p = first, last
+         c = particles%cell(p)
+         average(:, c) = average(:, c) + particles%mass(p) * values(:, p - first + 1)
+      end do
+      do c = 1, size(cell_mass)
+         if (cell_mass(c) > 0.0_rp) average(:, c) = average(:, c) / cell_mass(c)
+      end do
+   end subroutine cell_average
+
+   !> Replace values(:, p) of particles first..last by the average of their cell (C0: "replace, not
+   !> increment" [P]+[D], algorithms.md section 2.2).
+   subroutine replace_by_cell_average(particles, first, last, cell_mass, values)
+      type(particle_set_t), intent(in) :: particles
+      integer, intent(in) :: first, last
+      real(rp), intent(in) :: cell_mass(:)
+      real(rp), intent(inout) :: values(:, :)
+      real(rp), allocatable :: average(:, :)
+      integer :: p
+      allocate (average(size(values, 1), size(cell_mass)))
+      call cell_average(particles, first, last, cell_mass, values, average)
+      do p = first, last
+         values(:, p - first + 1) = average(:, particles%cell(p))
+      end do
+   end subroutine replace_by_cell_average
+end module cell_binning

@@ -1,0 +1,116 @@
+!> FOAL1, the limited constant-flux smoothing of [Y17] section 3 (algorithms.md section 3):
+!>   (a) C0 anti-locking of the rate of deformation (inherited from c0_anti_locking_t),
+!>   (b) constitutive update with d~ (done by the solver),
+!>   (c) cell-wise averaging q_c = sum m_p q_p / m_c of the smoothed variables ([Y17] section 3.2),
+!>   (d) limited face fluxes q^_c = q_c + dq_c (limited_flux_smoothing, eqs. 5-13),
+!>   (e) particle update q_p := q^_c (or q_p := q_p + dq_c with cell averaging off).
+!> q is every component of the mass-specific stress s = sigma / rho (default [R]) or the mass-specific
+!> pressure p / rho = -tr(s) / 3 only (frame-invariant option). With gamma_max = 0 no face is active
+!> and FOAL1 is C0, bit for bit. Cell data next to a subdomain boundary comes from a two-layer face
+!> halo exchange (cell_halo), so both ranks compute the same flux for a shared face.
+module foal1_smoothing
+   use kinds, only: rp
+   use particle_set, only: particle_set_t
+   use stabilizer, only: stage_context_t
+   use c0_anti_locking, only: c0_anti_locking_t
+   use cell_binning, only: bin_cell_centre, cell_average
+   use cell_halo, only: padded_cells_t, exchange_cell_halo
+   use limited_flux_smoothing, only: flux_options_t, limited_flux_increments
+   implicit none
+   private
+
+   type, extends(c0_anti_locking_t), public :: foal1_smoothing_t
+      type(flux_options_t) :: options
+      logical :: pressure_only = .false.       !< smooth p / rho only, not every stress component
+      logical :: cell_averaging = .true.       !< step (c); off: purely incremental update
+      type(padded_cells_t) :: box
+      real(rp), allocatable :: centre(:, :)    !< mass centre x_o^c of the owned cells at x^n
+   contains
+      procedure :: prepare => foal1_prepare
+      procedure :: filter_stress => foal1_filter_stress
+   end type foal1_smoothing_t
+
+contains
+
+   !> C0's cell masses plus the mass centres, at x^n.
+   subroutine foal1_prepare(self, context, particles)
+      class(foal1_smoothing_t), intent(inout) :: self
+      type(stage_context_t), intent(in) :: context
+      type(particle_set_t), intent(inout) :: particles
+      call self%c0_anti_locking_t%prepare(context, particles)
+      if (self%box%count == 0 .or. .not. allocated(self%centre)) then
+         call self%box%init(context%grid)
+      else if (size(self%centre, 2) /= context%grid%cell_count) then
+         call self%box%init(context%grid)
+      end if
+      if (allocated(self%centre)) deallocate (self%centre)
+      allocate (self%centre(context%grid%dim, context%grid%cell_count))
+      call bin_cell_centre(particles, context%first, context%last, &
+                           self%cell_mass, self%centre)
+   end subroutine foal1_prepare
+
+   !> Steps (c) to (e) for the material's particles.
+   subroutine foal1_filter_stress(self, context, particles)
+      class(foal1_smoothing_t), intent(inout) :: self
+      type(stage_context_t), intent(in) :: context
+      type(particle_set_t), intent(inout) :: particles
+      real(rp), allocatable :: q(:, :), q_cell(:, :), stress_cell(:, :), field(:, :), dq(:, :)
+      logical, allocatable :: exists(:)
+      integer :: first, last, nq, dim, p, i, c, row_q
+
+      first = context%first
+      last = context%last
+      dim = context%grid%dim
+      nq = merge(1, particles%n_sigma, self%pressure_only)
+
+      ! (c) cell averages of q on the owned cells
+      allocate (q(nq, max(0, last - first + 1)), q_cell(nq, context%grid%cell_count))
+      if (self%pressure_only) then
+         do p = first, last
+            q(1, p - first + 1) = -(particles%sbar(1, p) + particles%sbar(2, p) + particles%sbar(3, p)) / 3.0_rp
+         end do
+      else
+         q = particles%sbar(:, first:last)
+      end if
+      call cell_average(particles, first, last, self%cell_mass, q, q_cell)
+
+      ! padded cell field: exists, m_c, x_o^c, q_c; ghost layers from the neighbours (collective)
+      row_q = 3 + dim
+      allocate (field(2 + dim + nq, self%box%count))
+      field = 0.0_rp
+      do c = 1, context%grid%cell_count
+         if (self%cell_mass(c) <= 0.0_rp) cycle
+         i = self%box%of_owned(c)
+         field(1, i) = 1.0_rp
+         field(2, i) = self%cell_mass(c)
+         field(3:2 + dim, i) = self%centre(:, c)
+         field(row_q:, i) = q_cell(:, c)
+      end do
+      call exchange_cell_halo(context%domain, context%grid, self%box, field)
+      exists = field(1, :) > 0.5_rp
+
+      ! (d) limited face fluxes
+      allocate (dq(nq, self%box%count))
+      call limited_flux_increments(self%box, context%grid%h, exists, field(2, :), field(3:2 + dim, :), &
+                                   field(row_q:, :), self%options, dq)
+
+      ! (e) particle update
+      if (self%pressure_only .and. self%cell_averaging) then
+         allocate (stress_cell(particles%n_sigma, context%grid%cell_count))
+         call cell_average(particles, first, last, self%cell_mass, particles%sbar(:, first:last), stress_cell)
+      end if
+      do p = first, last
+         c = particles%cell(p)
+         i = self%box%of_owned(c)
+         if (self%pressure_only) then
+            ! q = p / rho = -tr(s) / 3: its increment enters the normal components with opposite sign
+            if (self%cell_averaging) particles%sbar(:, p) = stress_cell(:, c)
+            particles%sbar(1:3, p) = particles%sbar(1:3, p) - dq(1, i)
+         else if (self%cell_averaging) then
+            particles%sbar(:, p) = q_cell(:, c) + dq(:, i)
+         else
+            particles%sbar(:, p) = particles%sbar(:, p) + dq(:, i)
+         end if
+      end do
+   end subroutine foal1_filter_stress
+end module foal1_smoothing

@@ -1,0 +1,233 @@
+!> The stabilization schemes inside the solver, on any number of ranks:
+!>  - FOAL1 smoothing of a random field and of a checkerboard gives the same particle values on one
+!>    rank and on all ranks of `comm` (<= 1e-13 relative): the cell halo carries what the fluxes need;
+!>  - FOAL1 with gamma_max = 0 is C0, bit for bit;
+!>  - C0 in 2-D is one-point quadrature at the cell mass centre (algorithms.md section 2.2).
+module test_stabilization_consistency
+   use kinds, only: rp, i8
+   use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_split, MPI_Comm_free, MPI_Allreduce, MPI_Bcast, &
+                      MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_SUM, MPI_UNDEFINED, MPI_COMM_NULL, operator(/=)
+   use assertions, only: assertTrue, assertEqual
+   use error_status, only: status_t
+   use scene_description, only: scene_t
+   use mpm_solver, only: solver_t
+   use run_diagnostics, only: diagnostics_t
+   use stabilizer, only: stage_context_t
+   use grid_transfer, only: grid_to_particles
+   use shape_functions, only: n_corners, corner_offset, shape_values_and_gradients
+   use test_scenes, only: water_scene, add_body
+   implicit none
+   private
+
+   public :: test_random_field_rank_invariance, test_checkerboard_rank_invariance, test_random_field_3d_rank_invariance, &
+             test_gamma_zero_is_c0, test_c0_is_one_point_quadrature_2d
+
+   integer, parameter :: random_field = 1, checkerboard = 2
+
+contains
+
+   !> A water block of 20 x 12 cells (2-D) filling part of a tank, 2 x 2 particles per cell, one body:
+   !> particle ids run 0 .. n - 1.
+   function block_scene(dim, scheme) result(scene)
+      integer, intent(in) :: dim
+      character(len=*), intent(in) :: scheme
+      type(scene_t) :: scene
+      scene = water_scene(dim, 0.1_rp, [3.0_rp, 2.0_rp, 0.8_rp], 2.0e6_rp, 10.0_rp)
+      call add_body(scene, 1, [0.3_rp, 0.0_rp, 0.0_rp], [2.3_rp, 1.2_rp, 0.6_rp], 2, .true., 1.2_rp)
+      scene%materials(1)%stabilization = scheme
+   end function block_scene
+
+   subroutine test_random_field_rank_invariance(comm)
+      type(MPI_Comm), intent(in) :: comm
+      call compare_smoothing(comm, 2, random_field)
+   end subroutine test_random_field_rank_invariance
+
+   subroutine test_checkerboard_rank_invariance(comm)
+      type(MPI_Comm), intent(in) :: comm
+      call compare_smoothing(comm, 2, checkerboard)
+   end subroutine test_checkerboard_rank_invariance
+
+   subroutine test_random_field_3d_rank_invariance(comm)
+      type(MPI_Comm), intent(in) :: comm
+      call compare_smoothing(comm, 3, random_field)
+   end subroutine test_random_field_3d_rank_invariance
+
+   !> Smooth the same field on one rank and on all ranks; compare particle by particle (by id).
+   subroutine compare_smoothing(comm, dim, pattern)
+      type(MPI_Comm), intent(in) :: comm
+      integer, intent(in) :: dim, pattern
+      type(MPI_Comm) :: serial
+      real(rp), allocatable :: one(:, :), all(:, :)
+      integer :: rank, n
+      call MPI_Comm_rank(comm, rank)
+      call MPI_Comm_split(comm, merge(0, MPI_UNDEFINED, rank == 0), 0, serial)
+      call smoothed_field(comm, dim, pattern, all)
+      n = size(all)
+      allocate (one(size(all, 1), size(all, 2)))
+      one = 0.0_rp
+      if (serial /= MPI_COMM_NULL) then
+         call smoothed_field(serial, dim, pattern, one)
+         call MPI_Comm_free(serial)
+      end if
+      call MPI_Bcast(one, n, MPI_DOUBLE_PRECISION, 0, comm)
+      call assertTrue(maxval(abs(all)) > 0.0_rp, 'field present')
+      call assertEqual(0.0_rp, maxval(abs(all - one)) / maxval(abs(one)), 1.0e-13_rp, 'same smoothing on 1 and N ranks')
+      call assertTrue(maxval(abs(all - initial_field(dim, pattern, size(all, 2)))) > 0.0_rp, 'the field was smoothed')
+   end subroutine compare_smoothing
+
+   !> The field before smoothing, by particle id (as set in smoothed_field).
+   function initial_field(dim, pattern, n) result(field)
+      integer, intent(in) :: dim, pattern, n
+      real(rp), allocatable :: field(:, :)
+      integer :: i
+      allocate (field(merge(4, 6, dim == 2), n))
+      do i = 1, n
+         field(:, i) = value_of(int(i - 1, i8), [0, 0, 0], pattern, size(field, 1))
+      end do
+   end function initial_field
+
+   !> sbar of a particle: pseudo-random from its id, or +-1 by the parity of its cell.
+   pure function value_of(id, cell, pattern, n_sigma) result(v)
+      integer(i8), intent(in) :: id
+      integer, intent(in) :: cell(3), pattern, n_sigma
+      real(rp) :: v(n_sigma)
+      integer :: j
+      do j = 1, n_sigma
+         if (pattern == random_field) then
+            v(j) = 1.0e3_rp * (modulo(sin(real(id * 7 + j, rp) * 12.9898_rp) * 43758.5453_rp, 1.0_rp) - 0.5_rp)
+         else
+            v(j) = real((-1)**(sum(cell)), rp)
+         end if
+      end do
+   end function value_of
+
+   !> Build the solver with FOAL1 on `comm`, set the field, run FOAL1's stress stage once, return the
+   !> particle values (n_sigma, n_particles) indexed by id + 1, summed over ranks.
+   subroutine smoothed_field(comm, dim, pattern, field)
+      type(MPI_Comm), intent(in) :: comm
+      integer, intent(in) :: dim, pattern
+      real(rp), allocatable, intent(inout) :: field(:, :)
+      type(solver_t), target :: solver
+      type(status_t) :: status
+      type(stage_context_t) :: context
+      integer :: p, n_total
+      real(rp) :: count_real
+
+      call solver%init(block_scene(dim, 'FOAL1'), comm, status)
+      call assertTrue(status%ok, 'solver init: '//trim(status%message))
+      do p = 1, solver%particles%count
+         solver%particles%sbar(:, p) = value_of(solver%particles%id(p), &
+                                                solver%grid%cell_of_position(solver%particles%x(:, p)), pattern, &
+                                                solver%particles%n_sigma)
+      end do
+      context%domain => solver%domain
+      context%grid => solver%grid
+      context%first = solver%particles%material_first(1)
+      context%last = solver%particles%material_last(1)
+      call solver%schemes(1)%scheme%prepare(context, solver%particles)
+      call solver%schemes(1)%scheme%filter_stress(context, solver%particles)
+
+      count_real = real(solver%particles%count, rp)
+      call MPI_Allreduce(MPI_IN_PLACE, count_real, 1, MPI_DOUBLE_PRECISION, MPI_SUM, comm)
+      n_total = nint(count_real)
+      if (.not. allocated(field)) allocate (field(solver%particles%n_sigma, n_total))
+      field = 0.0_rp
+      do p = 1, solver%particles%count
+         field(:, solver%particles%id(p) + 1) = solver%particles%sbar(:, p)
+      end do
+      call MPI_Allreduce(MPI_IN_PLACE, field, size(field), MPI_DOUBLE_PRECISION, MPI_SUM, comm)
+      call solver%free()
+   end subroutine smoothed_field
+
+   !> FOAL1 with gamma_max = 0 and C0 run 50 steps of a collapsing block to bitwise the same state.
+   subroutine test_gamma_zero_is_c0(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(solver_t) :: c0, foal1
+      type(scene_t) :: scene
+      type(status_t) :: status
+      type(diagnostics_t) :: diag
+      integer :: step, n
+      scene = block_scene(2, 'C0')
+      scene%bodies(1)%hydrostatic = .false.
+      call c0%init(scene, comm, status)
+      scene%materials(1)%stabilization = 'FOAL1'
+      scene%materials(1)%gamma_max = 0.0_rp
+      call foal1%init(scene, comm, status)
+      do step = 1, 50
+         call c0%advance()
+         call foal1%advance()
+      end do
+      call assertEqual(c0%particles%count, foal1%particles%count, 'same particles')
+      n = c0%particles%count
+      ! bitwise: the largest difference is exactly zero
+      call assertEqual(0.0_rp, maxval(abs(c0%particles%sbar(:, 1:n) - foal1%particles%sbar(:, 1:n))), 0.0_rp, &
+                       'stresses bitwise equal')
+      call assertEqual(0.0_rp, maxval(abs(c0%particles%x(:, 1:n) - foal1%particles%x(:, 1:n))), 0.0_rp, &
+                       'positions bitwise equal')
+      diag = c0%diagnostics()
+      call assertTrue(diag%kinetic_energy > 0.0_rp, 'the block moved')
+      call c0%free()
+      call foal1%free()
+   end subroutine test_gamma_zero_is_c0
+
+   !> With nodal velocities v_i arbitrary, C0's cell average of d_p equals sym(sum v_i (x) grad N_i(x_o^c))
+   !> at the cell's mass centre x_o^c: sum_p m_p grad N_i(x_p) = m_c grad N_i(x_o^c) for bilinear N.
+   subroutine test_c0_is_one_point_quadrature_2d(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(solver_t), target :: solver
+      type(scene_t) :: scene
+      type(status_t) :: status
+      type(stage_context_t) :: context
+      real(rp), allocatable :: centre(:, :), mass(:), x_n(:, :)
+      real(rp) :: xi(2), n(4), g(2, 4), l(2, 2), d_expected(4), c_real(3)
+      integer :: i, p, c, a, k, cell(3), base, checked
+      scene = block_scene(2, 'C0')
+      ! particles away from the lattice of cell centres, so that mass centres are not cell centres
+      scene%bodies(1)%lower(1) = 0.33_rp
+      scene%bodies(1)%upper(1) = 2.33_rp
+      scene%bodies(1)%particles_per_cell = 3
+      call solver%init(scene, comm, status)
+      call assertTrue(status%ok, 'solver init: '//trim(status%message))
+      do i = 1, solver%grid%node_count
+         solver%grid%velocity(:, i) = [sin(1.7_rp * i), cos(0.3_rp * i**2)]
+      end do
+      solver%grid%velocity_increment = 0.0_rp
+      context%domain => solver%domain
+      context%grid => solver%grid
+      context%first = solver%particles%material_first(1)
+      context%last = solver%particles%material_last(1)
+      x_n = solver%particles%x(:, 1:solver%particles%count)
+      call solver%schemes(1)%scheme%prepare(context, solver%particles)
+      call grid_to_particles(solver%grid, solver%particles, 1.0e-3_rp, 1.0_rp, 1.0_rp, .false., .true., .false.)
+      call solver%schemes(1)%scheme%filter_strain_rate(context, solver%particles)
+      allocate (centre(2, solver%grid%cell_count), mass(solver%grid%cell_count))
+      centre = 0.0_rp
+      mass = 0.0_rp
+      do p = 1, solver%particles%count
+         c = solver%particles%cell(p)
+         mass(c) = mass(c) + solver%particles%mass(p)
+         centre(:, c) = centre(:, c) + solver%particles%mass(p) * x_n(:, p)
+      end do
+      checked = 0
+      do p = 1, solver%particles%count
+         c = solver%particles%cell(p)
+         cell = solver%grid%cell_of_position(x_n(:, p))
+         c_real = 0.0_rp
+         c_real(1:2) = centre(:, c) / mass(c)
+         xi = (c_real(1:2) - solver%grid%origin(1:2)) * solver%grid%inv_h - cell(1:2)
+         call shape_values_and_gradients(2, xi, solver%grid%inv_h, n, g)
+         base = solver%grid%local_node(cell(1:2))
+         l = 0.0_rp
+         do a = 1, n_corners(2)
+            do k = 1, 2
+               l(:, k) = l(:, k) + solver%grid%velocity(:, base + solver%grid%corner_stride(a)) * g(k, a)
+            end do
+         end do
+         d_expected = [l(1, 1), l(2, 2), 0.0_rp, 0.5_rp * (l(1, 2) + l(2, 1))]
+         call assertEqual(d_expected, solver%particles%strain_rate(:, p), 1.0e-11_rp, 'd~_c = d(x_o^c)')
+         checked = checked + 1
+      end do
+      call assertTrue(checked > 0 .and. corner_offset(4, 2) == 1, 'particles checked')
+      call solver%free()
+   end subroutine test_c0_is_one_point_quadrature_2d
+end module test_stabilization_consistency

@@ -1,0 +1,257 @@
+!> The limited constant-flux smoothing of FOAL1 on cell data (algorithms.md section 3.5): conservation,
+!> maximum principle, linear preservation, checkerboard removal in 2-D and 3-D, and inert empty,
+!> partly filled and foreign cells. One rank: the box's ghost layers lie outside the grid.
+module test_limited_flux_smoothing
+   use kinds, only: rp
+   use assertions, only: assertEqual, assertTrue
+   use domain_decomposition, only: domain_t
+   use background_grid, only: grid_t
+   use cell_halo, only: padded_cells_t
+   use limited_flux_smoothing, only: flux_options_t, limited_flux_increments
+   implicit none
+   private
+
+   public :: test_conservation_random_field, test_maximum_principle, test_linear_field_unchanged, &
+             test_checkerboard_2d, test_checkerboard_3d, test_empty_and_partial_cells, test_gamma_zero_no_flux
+
+   real(rp), parameter :: h = 0.5_rp
+
+   !> Cell data of one material on a padded box.
+   type :: cells_t
+      type(grid_t) :: grid
+      type(padded_cells_t) :: box
+      logical, allocatable :: exists(:)
+      real(rp), allocatable :: mass(:), centre(:, :), q(:, :), dq(:, :)
+   end type cells_t
+
+contains
+
+   !> n(1) x n(2) (x n(3)) cells, all filled uniformly: unit density, centres at the cell centres.
+   function uniform_cells(dim, n, nq) result(cells)
+      integer, intent(in) :: dim, n(3), nq
+      type(cells_t) :: cells
+      type(domain_t) :: domain
+      integer :: c, k, g(3)
+      domain%dim = dim
+      domain%global_cells = 1
+      domain%global_cells(1:dim) = n(1:dim)
+      domain%cell_lo = 0
+      domain%cell_hi = 0
+      domain%cell_hi(1:dim) = n(1:dim) - 1
+      call cells%grid%init(domain, [0.0_rp, 0.0_rp, 0.0_rp], h)
+      call cells%box%init(cells%grid)
+      allocate (cells%exists(cells%box%count), cells%mass(cells%box%count), cells%centre(dim, cells%box%count), &
+                cells%q(nq, cells%box%count), cells%dq(nq, cells%box%count))
+      cells%exists = cells%box%owned
+      cells%mass = merge(h**dim, 0.0_rp, cells%exists)
+      cells%q = 0.0_rp
+      do c = 1, cells%box%count
+         g = global_cell(cells%box, c)
+         do k = 1, dim
+            cells%centre(k, c) = (g(k) + 0.5_rp) * h
+         end do
+      end do
+   end function uniform_cells
+
+   !> Global cell indices of padded cell c.
+   pure function global_cell(box, c) result(g)
+      type(padded_cells_t), intent(in) :: box
+      integer, intent(in) :: c
+      integer :: g(3), k
+      do k = 1, 3
+         g(k) = box%lo(k) + mod((c - 1) / box%stride(k), box%n(k))
+      end do
+   end function global_cell
+
+   subroutine smooth(cells, options)
+      type(cells_t), intent(inout) :: cells
+      type(flux_options_t), intent(in), optional :: options
+      type(flux_options_t) :: defaults
+      if (present(options)) defaults = options
+      call limited_flux_increments(cells%box, h, cells%exists, cells%mass, cells%centre, cells%q, defaults, cells%dq)
+   end subroutine smooth
+
+   !> A reproducible pseudo-random number in [0, 1) from an integer.
+   pure real(rp) function hash01(i)
+      integer, intent(in) :: i
+      hash01 = modulo(sin(real(i, rp) * 12.9898_rp) * 43758.5453_rp, 1.0_rp)
+   end function hash01
+
+   !> Random masses, mass centres inside the cells and values: sum_c m_c q^_c = sum_c m_c q_c.
+   subroutine test_conservation_random_field()
+      type(cells_t) :: cells
+      integer :: c, j, dim, k, g(3)
+      real(rp) :: before, after, scale
+      do dim = 2, 3
+         cells = uniform_cells(dim, [7, 6, 5], 4)
+         do c = 1, cells%box%count
+            if (.not. cells%exists(c)) cycle
+            g = global_cell(cells%box, c)
+            cells%mass(c) = h**dim * (0.1_rp + hash01(3 * c))
+            do k = 1, dim
+               cells%centre(k, c) = (g(k) + 0.05_rp + 0.9_rp * hash01(5 * c + k)) * h
+            end do
+            do j = 1, 4
+               cells%q(j, c) = 1.0e4_rp * (hash01(7 * c + j) - 0.5_rp)
+            end do
+         end do
+         call smooth(cells)
+         do j = 1, 4
+            before = sum(cells%mass * cells%q(j, :), mask=cells%exists)
+            after = sum(cells%mass * (cells%q(j, :) + cells%dq(j, :)), mask=cells%exists)
+            scale = sum(cells%mass * abs(cells%q(j, :)), mask=cells%exists)
+            call assertEqual(before, after, 1.0e-14_rp * scale, 'sum m q conserved')
+         end do
+         call assertTrue(maxval(abs(cells%dq)) > 0.0_rp, 'the random field was smoothed')
+      end do
+   end subroutine test_conservation_random_field
+
+   !> Every smoothed value lies between the extremes of its cell and face neighbours.
+   subroutine test_maximum_principle()
+      type(cells_t) :: cells
+      integer :: c, k, dim, g(3)
+      real(rp) :: low, high, smoothed
+      do dim = 2, 3
+         cells = uniform_cells(dim, [8, 7, 4], 1)
+         do c = 1, cells%box%count
+            if (.not. cells%exists(c)) cycle
+            g = global_cell(cells%box, c)
+            cells%mass(c) = h**dim * (0.2_rp + hash01(11 * c))
+            cells%q(1, c) = 100.0_rp * (hash01(13 * c) - 0.5_rp)
+         end do
+         call smooth(cells)
+         do c = 1, cells%box%count
+            if (.not. cells%exists(c)) cycle
+            low = cells%q(1, c)
+            high = cells%q(1, c)
+            do k = 1, dim
+               associate (l => c - cells%box%stride(k), r => c + cells%box%stride(k))
+                  if (cells%exists(l)) low = min(low, cells%q(1, l))
+                  if (cells%exists(l)) high = max(high, cells%q(1, l))
+                  if (cells%exists(r)) low = min(low, cells%q(1, r))
+                  if (cells%exists(r)) high = max(high, cells%q(1, r))
+               end associate
+            end do
+            smoothed = cells%q(1, c) + cells%dq(1, c)
+            call assertTrue(smoothed >= low - 1.0e-12_rp .and. smoothed <= high + 1.0e-12_rp, 'no new extremum')
+         end do
+      end do
+   end subroutine test_maximum_principle
+
+   !> A linear field on uniformly filled cells (the hydrostatic state) is left exactly as it is.
+   subroutine test_linear_field_unchanged()
+      type(cells_t) :: cells
+      integer :: c, dim
+      do dim = 2, 3
+         cells = uniform_cells(dim, [6, 8, 5], 2)
+         do c = 1, cells%box%count
+            if (.not. cells%exists(c)) cycle
+            cells%q(1, c) = -1.0e4_rp * (3.2_rp - cells%centre(dim, c))     ! hydrostatic pressure profile
+            cells%q(2, c) = 2.0_rp * cells%centre(1, c) - 3.0_rp * cells%centre(2, c) + 0.5_rp
+         end do
+         call smooth(cells)
+         call assertEqual(0.0_rp, maxval(abs(cells%dq)), 1.0e-9_rp, 'linear field unchanged')
+      end do
+   end subroutine test_linear_field_unchanged
+
+   !> q = +-A checkerboard with equal masses on 8 x 6 cells: removed in one step in every cell whose face
+   !> neighbours all have two-sided slopes (two cells or more from the edge). Next to the edge the
+   !> one-sided slope of an edge cell makes part of the jump "allowable" (docs/theory.md, section on
+   !> FOAL1): |q^| = 3/8 A on an edge (A/8 across the face to the interior, 2 x A/4 along the edge),
+   !> 1/2 A beside a corner, 3/4 A in a corner; 1/8 A in the second ring, 1/4 A at its corners.
+   subroutine test_checkerboard_2d()
+      type(cells_t) :: cells
+      integer :: c, g(3), distance(2)
+      real(rp), parameter :: a = 1.0_rp
+      real(rp) :: smoothed, expected
+      cells = uniform_cells(2, [8, 6, 1], 1)
+      do c = 1, cells%box%count
+         g = global_cell(cells%box, c)
+         if (cells%exists(c)) cells%q(1, c) = a * (-1)**(g(1) + g(2))
+      end do
+      call smooth(cells)
+      do c = 1, cells%box%count
+         if (.not. cells%exists(c)) cycle
+         g = global_cell(cells%box, c)
+         distance = [min(g(1), 7 - g(1)), min(g(2), 5 - g(2))]    ! to the edge, along x and along y
+         smoothed = abs(cells%q(1, c) + cells%dq(1, c))
+         if (minval(distance) >= 2) then
+            expected = 0.0_rp
+         else if (all(distance == 0)) then
+            expected = 0.75_rp * a
+         else if (minval(distance) == 0 .and. maxval(distance) == 1) then
+            expected = 0.5_rp * a
+         else if (minval(distance) == 0) then
+            expected = 0.375_rp * a
+         else if (all(distance == 1)) then
+            expected = 0.25_rp * a
+         else
+            expected = 0.125_rp * a
+         end if
+         call assertEqual(expected, smoothed, 1.0e-14_rp, 'checkerboard after one step')
+      end do
+   end subroutine test_checkerboard_2d
+
+   subroutine test_checkerboard_3d()
+      type(cells_t) :: cells
+      integer :: c, g(3), interior
+      cells = uniform_cells(3, [6, 6, 7], 1)
+      do c = 1, cells%box%count
+         g = global_cell(cells%box, c)
+         if (cells%exists(c)) cells%q(1, c) = (-1.0_rp)**(g(1) + g(2) + g(3))
+      end do
+      call smooth(cells)
+      interior = 0
+      do c = 1, cells%box%count
+         if (.not. cells%exists(c)) cycle
+         g = global_cell(cells%box, c)
+         if (minval([g(1), g(2), g(3), 5 - g(1), 5 - g(2), 6 - g(3)]) < 2) cycle
+         interior = interior + 1
+         call assertEqual(0.0_rp, cells%q(1, c) + cells%dq(1, c), 1.0e-14_rp, '3-D interior checkerboard removed')
+      end do
+      call assertEqual(2 * 2 * 3, interior, 'interior cells checked')
+   end subroutine test_checkerboard_3d
+
+   !> Empty cells, a partly filled cell and cells holding only another material (not "existing" for
+   !> this one) get no flux and produce no NaN; fluxes still flow between the existing cells.
+   subroutine test_empty_and_partial_cells()
+      type(cells_t) :: cells
+      integer :: c, g(3)
+      cells = uniform_cells(2, [8, 8, 1], 1)
+      do c = 1, cells%box%count
+         if (.not. cells%exists(c)) cycle
+         g = global_cell(cells%box, c)
+         cells%q(1, c) = (-1.0_rp)**(g(1) + g(2))
+         if (g(1) == 4) then                  ! a column of cells with only the other material
+            cells%exists(c) = .false.
+            cells%mass(c) = 0.0_rp
+            cells%q(1, c) = huge(1.0_rp)      ! whatever is stored there must not be read
+         end if
+         if (g(1) == 2 .and. g(2) == 3) then  ! a partly filled cell: little mass near its lower face
+            cells%mass(c) = 1.0e-6_rp * h**2
+            cells%centre(2, c) = (g(2) + 1.0e-9_rp) * h
+         end if
+      end do
+      call smooth(cells)
+      call assertTrue(all(abs(cells%dq) < 10.0_rp), 'finite increments everywhere')
+      do c = 1, cells%box%count
+         if (.not. cells%exists(c)) call assertEqual(0.0_rp, cells%dq(1, c), 0.0_rp, 'no flux into a foreign cell')
+      end do
+      call assertTrue(maxval(abs(cells%dq)) > 0.0_rp, 'existing cells still smoothed')
+   end subroutine test_empty_and_partial_cells
+
+   !> gamma_max = 0 opens no face: all increments are exactly zero (FOAL1 reduces to C0).
+   subroutine test_gamma_zero_no_flux()
+      type(cells_t) :: cells
+      type(flux_options_t) :: options
+      integer :: c, g(3)
+      cells = uniform_cells(2, [8, 6, 1], 1)
+      do c = 1, cells%box%count
+         g = global_cell(cells%box, c)
+         if (cells%exists(c)) cells%q(1, c) = (-1.0_rp)**(g(1) + g(2))
+      end do
+      options%gamma_max = 0.0_rp
+      call smooth(cells, options)
+      call assertEqual(0.0_rp, maxval(abs(cells%dq)), 0.0_rp, 'no increment with gamma_max = 0')
+   end subroutine test_gamma_zero_no_flux
+end module test_limited_flux_smoothing
