@@ -18,6 +18,7 @@ module c0_anti_locking
    type, extends(stabilizer_t), public :: c0_anti_locking_t
       logical :: volumetric_only = .false.
       real(rp), allocatable :: cell_mass(:)      !< m_c of the owned cells (this material)
+      real(rp), allocatable :: average(:, :)     !< work: cell averages (kept between steps)
    contains
       procedure :: prepare => c0_prepare
       procedure :: filter_strain_rate => c0_filter_strain_rate
@@ -31,11 +32,11 @@ contains
       class(c0_anti_locking_t), intent(inout) :: self
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
-      if (.not. allocated(self%cell_mass)) allocate (self%cell_mass(context%grid%cell_count))
-      if (size(self%cell_mass) /= context%grid%cell_count) then
-         deallocate (self%cell_mass)
-         allocate (self%cell_mass(context%grid%cell_count))
+      if (allocated(self%cell_mass)) then
+         if (size(self%cell_mass) /= context%grid%cell_count) deallocate (self%cell_mass, self%average)
       end if
+      if (.not. allocated(self%cell_mass)) &
+         allocate (self%cell_mass(context%grid%cell_count), self%average(particles%n_sigma, context%grid%cell_count))
       call bin_cell_mass(particles, context%first, context%last, &
                          self%cell_mass)
    end subroutine c0_prepare
@@ -53,7 +54,8 @@ contains
          call replace_volumetric_part(self, particles, first, last, particles%strain_rate(:, first:last), &
                                       context%grid%dim)
       else
-         call replace_by_cell_average(particles, first, last, self%cell_mass, particles%strain_rate(:, first:last))
+         call replace_by_cell_average(particles, first, last, self%cell_mass, particles%strain_rate(:, first:last), &
+                                      self%average)
       end if
    end subroutine c0_filter_strain_rate
 
@@ -69,14 +71,14 @@ contains
       if (self%volumetric_only) then
          call replace_volumetric_part(self, particles, first, last, particles%sbar(:, first:last), 3)
       else
-         call replace_by_cell_average(particles, first, last, self%cell_mass, particles%sbar(:, first:last))
+         call replace_by_cell_average(particles, first, last, self%cell_mass, particles%sbar(:, first:last), self%average)
       end if
    end subroutine c0_filter_stress
 
    !> Replace the mean of the first n_normal normal components by its cell average:
    !> t_p(k) += (mean_c - mean_p) for k = 1..n_normal.
    subroutine replace_volumetric_part(self, particles, first, last, tensors, n_normal)
-      type(c0_anti_locking_t), intent(in) :: self
+      type(c0_anti_locking_t), intent(inout) :: self
       type(particle_set_t), intent(in) :: particles
       integer, intent(in) :: first, last, n_normal
       real(rp), intent(inout) :: tensors(:, :)
@@ -86,7 +88,7 @@ contains
       do p = 1, last - first + 1
          mean(1, p) = sum(tensors(1:n_normal, p)) / n_normal
       end do
-      call replace_by_cell_average(particles, first, last, self%cell_mass, mean)
+      call replace_by_cell_average(particles, first, last, self%cell_mass, mean, self%average)
       do p = 1, last - first + 1
          tensors(1:n_normal, p) = tensors(1:n_normal, p) - sum(tensors(1:n_normal, p)) / n_normal + mean(1, p)
       end do

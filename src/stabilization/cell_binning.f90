@@ -46,9 +46,9 @@ contains
       type(particle_set_t), intent(in) :: particles
       integer, intent(in) :: first, last
       real(rp), intent(in) :: cell_mass(:), values(:, :)
-      real(rp), intent(out) :: average(:, :)
+      real(rp), intent(inout) :: average(:, :)
       integer :: p, c
-      average = 0.0_rp
+      average(:, 1:size(cell_mass)) = 0.0_rp
       do p = first, last
          c = particles%cell(p)
          average(:, c) = average(:, c) + particles%mass(p) * values(:, p - first + 1)
@@ -60,14 +60,14 @@ contains
 
    !> Replace values(:, p) of particles first..last by the average of their cell (C0: "replace, not
    !> increment" [P]+[D], algorithms.md section 2.2).
-   subroutine replace_by_cell_average(particles, first, last, cell_mass, values)
+   !> `average` is work space of at least (size(values, 1), size(cell_mass)).
+   subroutine replace_by_cell_average(particles, first, last, cell_mass, values, average)
       type(particle_set_t), intent(in) :: particles
       integer, intent(in) :: first, last
       real(rp), intent(in) :: cell_mass(:)
       real(rp), intent(inout) :: values(:, :)
-      real(rp), allocatable :: average(:, :)
+      real(rp), intent(inout) :: average(:, :)
       integer :: p
-      allocate (average(size(values, 1), size(cell_mass)))
       call cell_average(particles, first, last, cell_mass, values, average)
       do p = first, last
          values(:, p - first + 1) = average(:, particles%cell(p))

@@ -14,8 +14,9 @@ module foal1_smoothing
    use stabilizer, only: stage_context_t
    use c0_anti_locking, only: c0_anti_locking_t
    use cell_binning, only: bin_cell_centre, cell_average
-   use cell_halo, only: padded_cells_t, exchange_cell_halo
-   use limited_flux_smoothing, only: flux_options_t, limited_flux_increments
+   use cell_halo, only: padded_cells_t, exchange_cell_halo, halo_width
+   use background_grid, only: grid_t
+   use limited_flux_smoothing, only: flux_options_t, flux_workspace_t, limited_flux_increments
    implicit none
    private
 
@@ -25,6 +26,10 @@ module foal1_smoothing
       logical :: cell_averaging = .true.       !< step (c); off: purely incremental update
       type(padded_cells_t) :: box
       real(rp), allocatable :: centre(:, :)    !< mass centre x_o^c of the owned cells at x^n
+      ! work arrays kept between steps
+      real(rp), allocatable :: q_cell(:, :), field(:, :), dq(:, :)
+      logical, allocatable :: exists(:)
+      type(flux_workspace_t) :: workspace
    contains
       procedure :: prepare => foal1_prepare
       procedure :: filter_stress => foal1_filter_stress
@@ -38,13 +43,11 @@ contains
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
       call self%c0_anti_locking_t%prepare(context, particles)
-      if (self%box%count == 0 .or. .not. allocated(self%centre)) then
-         call self%box%init(context%grid)
-      else if (size(self%centre, 2) /= context%grid%cell_count) then
-         call self%box%init(context%grid)
+      if (.not. same_cells(self%box, context%grid)) call self%box%init(context%grid)
+      if (allocated(self%centre)) then
+         if (size(self%centre, 2) /= context%grid%cell_count) deallocate (self%centre)
       end if
-      if (allocated(self%centre)) deallocate (self%centre)
-      allocate (self%centre(context%grid%dim, context%grid%cell_count))
+      if (.not. allocated(self%centre)) allocate (self%centre(context%grid%dim, context%grid%cell_count))
       call bin_cell_centre(particles, context%first, context%last, &
                            self%cell_mass, self%centre)
    end subroutine foal1_prepare
@@ -54,8 +57,7 @@ contains
       class(foal1_smoothing_t), intent(inout) :: self
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
-      real(rp), allocatable :: q(:, :), q_cell(:, :), stress_cell(:, :), field(:, :), dq(:, :)
-      logical, allocatable :: exists(:)
+      real(rp), allocatable :: q(:, :)
       integer :: first, last, nq, dim, p, i, c, row_q
 
       first = context%first
@@ -63,21 +65,23 @@ contains
       dim = context%grid%dim
       nq = merge(1, particles%n_sigma, self%pressure_only)
 
+      call ensure_work_arrays(self, nq, dim, context%grid%cell_count)
+
       ! (c) cell averages of q on the owned cells
-      allocate (q(nq, max(0, last - first + 1)), q_cell(nq, context%grid%cell_count))
+      associate (q_cell => self%q_cell, field => self%field, dq => self%dq, exists => self%exists)
       if (self%pressure_only) then
+         allocate (q(nq, max(0, last - first + 1)))
          do p = first, last
             q(1, p - first + 1) = -(particles%sbar(1, p) + particles%sbar(2, p) + particles%sbar(3, p)) / 3.0_rp
          end do
+         call cell_average(particles, first, last, self%cell_mass, q, q_cell)
       else
-         q = particles%sbar(:, first:last)
+         call cell_average(particles, first, last, self%cell_mass, particles%sbar(:, first:last), q_cell)
       end if
-      call cell_average(particles, first, last, self%cell_mass, q, q_cell)
 
       ! padded cell field: exists, m_c, x_o^c, q_c; ghost layers from the neighbours (collective)
       row_q = 3 + dim
-      allocate (field(2 + dim + nq, self%box%count))
-      field = 0.0_rp
+      field(1, :) = 0.0_rp      ! "exists"; the other rows are read only where it is set
       do c = 1, context%grid%cell_count
          if (self%cell_mass(c) <= 0.0_rp) cycle
          i = self%box%of_owned(c)
@@ -90,21 +94,18 @@ contains
       exists = field(1, :) > 0.5_rp
 
       ! (d) limited face fluxes
-      allocate (dq(nq, self%box%count))
       call limited_flux_increments(self%box, context%grid%h, exists, field(2, :), field(3:2 + dim, :), &
-                                   field(row_q:, :), self%options, dq)
+                                   field(row_q:, :), self%options, dq, self%workspace)
 
       ! (e) particle update
-      if (self%pressure_only .and. self%cell_averaging) then
-         allocate (stress_cell(particles%n_sigma, context%grid%cell_count))
-         call cell_average(particles, first, last, self%cell_mass, particles%sbar(:, first:last), stress_cell)
-      end if
+      if (self%pressure_only .and. self%cell_averaging) &
+         call cell_average(particles, first, last, self%cell_mass, particles%sbar(:, first:last), self%average)
       do p = first, last
          c = particles%cell(p)
          i = self%box%of_owned(c)
          if (self%pressure_only) then
             ! q = p / rho = -tr(s) / 3: its increment enters the normal components with opposite sign
-            if (self%cell_averaging) particles%sbar(:, p) = stress_cell(:, c)
+            if (self%cell_averaging) particles%sbar(:, p) = self%average(:, c)
             particles%sbar(1:3, p) = particles%sbar(1:3, p) - dq(1, i)
          else if (self%cell_averaging) then
             particles%sbar(:, p) = q_cell(:, c) + dq(:, i)
@@ -112,5 +113,26 @@ contains
             particles%sbar(:, p) = particles%sbar(:, p) + dq(:, i)
          end if
       end do
+      end associate
    end subroutine foal1_filter_stress
+
+   !> Size the work arrays for nq smoothed values on the current cells (kept while the sizes hold).
+   subroutine ensure_work_arrays(self, nq, dim, cell_count)
+      type(foal1_smoothing_t), intent(inout) :: self
+      integer, intent(in) :: nq, dim, cell_count
+      if (allocated(self%q_cell)) then
+         if (size(self%q_cell, 2) == cell_count .and. size(self%field, 2) == self%box%count) return
+         deallocate (self%q_cell, self%field, self%dq, self%exists)
+      end if
+      allocate (self%q_cell(nq, cell_count), self%field(2 + dim + nq, self%box%count), self%dq(nq, self%box%count), &
+                self%exists(self%box%count))
+   end subroutine ensure_work_arrays
+
+   !> True if the padded box was built for the cells the grid owns now (they move when ranks rebalance).
+   pure logical function same_cells(box, grid)
+      type(padded_cells_t), intent(in) :: box
+      type(grid_t), intent(in) :: grid
+      same_cells = box%count > 0 .and. all(box%lo(1:grid%dim) == grid%cell_lo(1:grid%dim) - halo_width) .and. &
+                   all(box%hi(1:grid%dim) == grid%cell_hi(1:grid%dim) + halo_width)
+   end function same_cells
 end module foal1_smoothing

@@ -26,109 +26,148 @@ module limited_flux_smoothing
    !> of h are treated as this far apart [R] (algorithms.md section 3.3, step 1).
    real(rp), parameter :: min_centre_distance = 1.0e-3_rp
    !> Noise guard of the oscillation test [R] (algorithms.md section 3.3, step 2): a difference between
-   !> neighbours smaller than this fraction of the largest |q| of the three cells counts as zero. Without
+   !> neighbours smaller than this fraction of the largest |q| (any component) of the three cells counts
+   !> as zero. Without
    !> it, a field that is flat along an axis (a tank at rest, across its width) has its oscillation flags
    !> decided by round-off, which then opens faces with O(1) jumps at random and makes the result depend
    !> on the order of floating-point sums (for instance on the number of MPI ranks).
    real(rp), parameter :: noise_guard = 1.0e-10_rp
+
+   !> Work arrays of limited_flux_increments, kept between calls (a step must not page in fresh memory).
+   type, public :: flux_workspace_t
+      logical, allocatable :: oscillating(:, :)
+   end type flux_workspace_t
 
    public :: limited_flux_increments
 
 contains
 
    !> dq(:, c) for every owned padded cell c (zero elsewhere). `exists` marks cells holding this material
-   !> (owned and ghost); q(:, c), mass(c), centre(:, c) are read only where exists(c).
-   subroutine limited_flux_increments(box, h, exists, mass, centre, q, options, dq)
+   !> (owned and ghost); q(:, c), mass(c), centre(:, c) are read only where exists(c). `workspace` keeps
+   !> the work arrays between calls.
+   subroutine limited_flux_increments(box, h, exists, mass, centre, q, options, dq, workspace)
       type(padded_cells_t), intent(in) :: box
       real(rp), intent(in) :: h
       logical, intent(in) :: exists(:)
       real(rp), intent(in) :: mass(:), centre(:, :), q(:, :)
       type(flux_options_t), intent(in) :: options
       real(rp), intent(out) :: dq(:, :)
-      real(rp), allocatable :: slope(:, :)
-      logical, allocatable :: oscillating(:, :)
-      integer :: k, nq, c, stride, along, j
-      real(rp) :: n_faces, flux, jump, limited_jump, x_m, allowed, d_min
+      type(flux_workspace_t), intent(inout) :: workspace
+      integer :: k, nq, c, stride, along, j, i1, i2, i3, position(3)
+      real(rp) :: n_faces, flux, jump, limited_jump, x_m, allowed, d_min, slope_minus(size(q, 1)), &
+                  slope_plus(size(q, 1))
       logical :: active
 
       nq = size(q, 1)
       n_faces = real(2 * box%dim, rp)
       d_min = min_centre_distance * h
       dq = 0.0_rp
-      allocate (slope(nq, box%count), oscillating(nq, box%count))
+      if (allocated(workspace%oscillating)) then
+         if (any(shape(workspace%oscillating) /= [nq, box%count])) deallocate (workspace%oscillating)
+      end if
+      if (.not. allocated(workspace%oscillating)) allocate (workspace%oscillating(nq, box%count))
+      associate (oscillating => workspace%oscillating)
       do k = 1, box%dim
          stride = box%stride(k)
-         ! slopes and oscillation flags of every cell that has both neighbours inside the padded box
-         do c = 1, box%count
-            along = position_along(box, c, k)
-            if (.not. exists(c) .or. along == 1 .or. along == box%n(k)) then
-               slope(:, c) = 0.0_rp
-               oscillating(:, c) = .false.
-               cycle
-            end if
-            call cell_slope(exists(c - stride), exists(c + stride), centre(k, c - stride), centre(k, c), &
-                            centre(k, c + stride), q(:, c - stride), q(:, c), q(:, c + stride), d_min, &
-                            slope(:, c), oscillating(:, c))
-         end do
-         ! faces (c, c + stride) with both cells present and at least one owned
-         do c = 1, box%count
-            along = position_along(box, c, k)
-            if (along < 2 .or. along > box%n(k) - 2) cycle
-            if (.not. (exists(c) .and. exists(c + stride))) cycle
-            if (.not. (box%owned(c) .or. box%owned(c + stride))) cycle
-            associate (m_minus => mass(c), m_plus => mass(c + stride), &
-                       x_minus => centre(k, c), x_plus => centre(k, c + stride))
-               x_m = (m_minus * x_plus + m_plus * x_minus) / (m_minus + m_plus)         ! eq. 8
-               do j = 1, nq
-                  ! oscillation limiter (eq. 6): gamma_o = gamma_max on an active face, else no flux
-                  if (options%both_cells_oscillate) then
-                     active = oscillating(j, c) .and. oscillating(j, c + stride)
+         ! oscillation flags (eq. 6) of every cell with both neighbours inside the padded box
+         c = 0
+         do i3 = 1, box%n(3)
+            do i2 = 1, box%n(2)
+               do i1 = 1, box%n(1)
+                  c = c + 1
+                  if (.not. exists(c)) cycle
+                  position = [i1, i2, i3]
+                  along = position(k)
+                  if (along == 1 .or. along == box%n(k)) then
+                     oscillating(:, c) = .false.
+                  else if (exists(c - stride) .and. exists(c + stride)) then
+                     call oscillation_flags(q(:, c - stride), q(:, c), q(:, c + stride), oscillating(:, c))
                   else
-                     active = oscillating(j, c) .or. oscillating(j, c + stride)
+                     oscillating(:, c) = .false.     ! a cell missing a neighbour cannot be tested [?]
                   end if
-                  if (.not. active) cycle
-                  jump = q(j, c) - q(j, c + stride)
-                  allowed = (x_m - x_minus) * slope(j, c) - (x_m - x_plus) * slope(j, c + stride)   ! e_- - e_+
-                  limited_jump = sign0(jump) * min(max(sign0(jump) * (jump + allowed), 0.0_rp), abs(jump))  ! eq. 12
-                  flux = options%gamma_max * limited_jump / (n_faces * (m_minus + m_plus))   ! eqs. 5, 11, 1/n
-                  if (box%owned(c + stride)) dq(j, c + stride) = dq(j, c + stride) + m_minus * flux
-                  if (box%owned(c)) dq(j, c) = dq(j, c) - m_plus * flux
                end do
-            end associate
+            end do
+         end do
+         ! faces (c, c + stride) with both cells present, at least one owned, and an oscillating cell
+         c = 0
+         do i3 = 1, box%n(3)
+            do i2 = 1, box%n(2)
+               do i1 = 1, box%n(1)
+                  c = c + 1
+                  if (.not. exists(c)) cycle
+                  position = [i1, i2, i3]
+                  along = position(k)
+                  if (along < 2 .or. along > box%n(k) - 2) cycle
+                  if (.not. exists(c + stride)) cycle
+                  if (.not. (box%owned(c) .or. box%owned(c + stride))) cycle
+                  if (.not. (any(oscillating(:, c)) .or. any(oscillating(:, c + stride)))) cycle
+                  ! slopes (eq. 7) of the two cells, only for the faces that can carry a flux
+                  call cell_slope(box, exists, centre, q, c, k, d_min, slope_minus)
+                  call cell_slope(box, exists, centre, q, c + stride, k, d_min, slope_plus)
+                  associate (m_minus => mass(c), m_plus => mass(c + stride), &
+                             x_minus => centre(k, c), x_plus => centre(k, c + stride))
+                     x_m = (m_minus * x_plus + m_plus * x_minus) / (m_minus + m_plus)         ! eq. 8
+                     do j = 1, nq
+                        ! oscillation limiter (eq. 6): gamma_o = gamma_max on an active face, else no flux
+                        if (options%both_cells_oscillate) then
+                           active = oscillating(j, c) .and. oscillating(j, c + stride)
+                        else
+                           active = oscillating(j, c) .or. oscillating(j, c + stride)
+                        end if
+                        if (.not. active) cycle
+                        jump = q(j, c) - q(j, c + stride)
+                        allowed = (x_m - x_minus) * slope_minus(j) - (x_m - x_plus) * slope_plus(j)   ! e_- - e_+
+                        limited_jump = sign0(jump) * min(max(sign0(jump) * (jump + allowed), 0.0_rp), abs(jump))  ! eq. 12
+                        flux = options%gamma_max * limited_jump / (n_faces * (m_minus + m_plus))   ! eqs. 5, 11, 1/n
+                        if (box%owned(c + stride)) dq(j, c + stride) = dq(j, c + stride) + m_minus * flux
+                        if (box%owned(c)) dq(j, c) = dq(j, c) - m_plus * flux
+                     end do
+                  end associate
+               end do
+            end do
          end do
       end do
+      end associate
    end subroutine limited_flux_increments
 
-   !> Eq. 7 slope and eq. 6 oscillation flag of a cell with values qc from its lower (l) and upper (r)
-   !> neighbours along one axis. A cell missing a neighbour cannot oscillate [?] (default of the spec).
-   pure subroutine cell_slope(has_l, has_r, xl, xc, xr, ql, qc, qr, d_min, slope, oscillating)
-      logical, intent(in) :: has_l, has_r
-      real(rp), intent(in) :: xl, xc, xr, ql(:), qc(:), qr(:), d_min
-      real(rp), intent(out) :: slope(:)
+   !> Eq. 6 with the noise guard: (q_r - q_c)(q_c - q_l) < 0, both differences above round-off. The
+   !> round-off scale is that of the largest component of the three cells: a component that is zero in
+   !> exact arithmetic (the shear stress of a fluid at rest) carries noise at the scale of the others.
+   pure subroutine oscillation_flags(ql, qc, qr, oscillating)
+      real(rp), intent(in) :: ql(:), qc(:), qr(:)
       logical, intent(out) :: oscillating(:)
-      real(rp) :: noise(size(qc))
-      if (has_l .and. has_r) then
-         slope = (qr - ql) / max(xr - xl, d_min)
-         noise = noise_guard * max(abs(ql), abs(qc), abs(qr))
-         oscillating = (abs(qr - qc) > noise .and. abs(qc - ql) > noise) .and. (qr - qc) * (qc - ql) < 0.0_rp
-      else if (has_l) then
-         slope = (qc - ql) / max(xc - xl, d_min)
-         oscillating = .false.
-      else if (has_r) then
-         slope = (qr - qc) / max(xr - xc, d_min)
-         oscillating = .false.
+      real(rp) :: noise, left, right
+      integer :: j
+      noise = noise_guard * max(maxval(abs(ql)), maxval(abs(qc)), maxval(abs(qr)))
+      do j = 1, size(qc)
+         left = qc(j) - ql(j)
+         right = qr(j) - qc(j)
+         oscillating(j) = abs(right) > noise .and. abs(left) > noise .and. right * left < 0.0_rp
+      end do
+   end subroutine oscillation_flags
+
+   !> Eq. 7 slope along axis k of cell c (of a face that lies inside the padded box, so both of c's
+   !> neighbours along k are inside it too): central with both neighbours, one-sided with one, else 0.
+   pure subroutine cell_slope(box, exists, centre, q, c, k, d_min, slope)
+      type(padded_cells_t), intent(in) :: box
+      logical, intent(in) :: exists(:)
+      real(rp), intent(in) :: centre(:, :), q(:, :), d_min
+      integer, intent(in) :: c, k
+      real(rp), intent(out) :: slope(:)
+      integer :: l, r
+      l = c - box%stride(k)
+      r = c + box%stride(k)
+      if (exists(l) .and. exists(r)) then
+         slope = (q(:, r) - q(:, l)) / max(centre(k, r) - centre(k, l), d_min)
+      else if (exists(l)) then
+         slope = (q(:, c) - q(:, l)) / max(centre(k, c) - centre(k, l), d_min)
+      else if (exists(r)) then
+         slope = (q(:, r) - q(:, c)) / max(centre(k, r) - centre(k, c), d_min)
       else
          slope = 0.0_rp
-         oscillating = .false.
       end if
    end subroutine cell_slope
 
-   !> 1-based position of padded cell c along axis k.
-   pure integer function position_along(box, c, k)
-      type(padded_cells_t), intent(in) :: box
-      integer, intent(in) :: c, k
-      position_along = 1 + mod((c - 1) / box%stride(k), box%n(k))
-   end function position_along
 
    !> sign returning -1, 0 or +1 ([Y17] section 3.5).
    elemental real(rp) function sign0(x)

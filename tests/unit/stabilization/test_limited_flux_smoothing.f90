@@ -7,7 +7,7 @@ module test_limited_flux_smoothing
    use domain_decomposition, only: domain_t
    use background_grid, only: grid_t
    use cell_halo, only: padded_cells_t
-   use limited_flux_smoothing, only: flux_options_t, limited_flux_increments
+   use limited_flux_smoothing, only: flux_options_t, flux_workspace_t, limited_flux_increments
    implicit none
    private
 
@@ -67,8 +67,10 @@ contains
       type(cells_t), intent(inout) :: cells
       type(flux_options_t), intent(in), optional :: options
       type(flux_options_t) :: defaults
+      type(flux_workspace_t) :: workspace
       if (present(options)) defaults = options
-      call limited_flux_increments(cells%box, h, cells%exists, cells%mass, cells%centre, cells%q, defaults, cells%dq)
+      call limited_flux_increments(cells%box, h, cells%exists, cells%mass, cells%centre, cells%q, defaults, cells%dq, &
+                                   workspace)
    end subroutine smooth
 
    !> A reproducible pseudo-random number in [0, 1) from an integer.

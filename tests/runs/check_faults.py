@@ -1,0 +1,176 @@
+#!/usr/bin/python3
+"""Faults a run must survive (issue 4), each checked on the real program under mpiexec:
+
+  * kill -9 of every rank mid-run, restart from the latest checkpoint: the diagnostics of the finished
+    run are bitwise those of an uninterrupted run;
+  * SIGTERM to the ranks (what a batch system sends) and to mpirun: checkpoint written, exit status 5,
+    and the restarted run reaches the same end state;
+  * restart on another number of ranks: the end state equal to 1e-10 relative;
+  * a truncated checkpoint and one of another format version are refused with a clear message;
+  * an output folder that holds a previous run or cannot be written is refused before the run starts;
+    --overwrite replaces the previous run;
+  * a blow-up stops the run within the step, names step, time, rank, particle and quantity, and
+    leaves a last output for inspection.
+
+usage: check_faults.py <flotsam> <mpiexec> <tests/runs/scenes>"""
+
+import os
+import shutil
+import signal
+
+import h5py
+
+from flotsam_run import Checks, Flotsam, main_arguments, read_diagnostics, signal_ranks, wait_for_file
+
+RANKS = 2
+VALUE_COLUMNS = ["time", "total_mass", "kinetic_energy", "fluid_volume", "h_eq", "max_speed"]
+
+
+def error_lines(result):
+    return [line for line in result.stderr.splitlines() if line.startswith("flotsam: error:")]
+
+
+def interrupted_run(flotsam, checks, scene, name, wait_for, interrupt):
+    """Start a run, interrupt it once checkpoint `wait_for` exists, restart it from the latest
+    checkpoint; returns (the interrupted process, its stderr, the restart's CompletedProcess)."""
+    process = flotsam.start(scene, RANKS)
+    reached = wait_for_file(flotsam.path(name, "checkpoints", wait_for), process)
+    checks.check(reached, f"{name}: the run wrote {wait_for}")
+    interrupt(process)
+    _, stderr = process.communicate(timeout=300)
+    rows = read_diagnostics(flotsam.path(name))
+    checks.check(float(rows[-1]["time"]) < 0.15 * (1 - 1e-9), f"{name}: interrupted before the end",
+                 f"last row at t = {rows[-1]['time']}")
+    restart = flotsam.run(scene, RANKS, "--restart", "latest")
+    checks.check(restart.returncode == 0, f"{name}: the restart finished", restart.stderr[-2000:])
+    return process, stderr, restart
+
+
+def main():
+    flotsam_path, mpiexec, scenes, _ = main_arguments()
+    flotsam = Flotsam(flotsam_path, mpiexec, "faults")
+    checks = Checks()
+    template = os.path.join(scenes, "column.nml")
+
+    # --- the uninterrupted reference ------------------------------------------------------------
+    flotsam.remove("reference")
+    reference_scene = flotsam.scene(template, "reference.nml", "reference")
+    result = flotsam.run(reference_scene, RANKS)
+    checks.check(result.returncode == 0, "reference run", result.stderr[-2000:])
+    reference = read_diagnostics(flotsam.path("reference"))
+    with open(flotsam.path("reference", "diagnostics.csv")) as f:
+        reference_text = f.read()
+
+    def same_end_state(name):
+        with open(flotsam.path(name, "diagnostics.csv")) as f:
+            text = f.read()
+        checks.check(text == reference_text, f"{name}: diagnostics bitwise equal to the uninterrupted run",
+                     f"{len(text.splitlines())} rows against {len(reference_text.splitlines())}")
+
+    # --- kill -9 of every rank mid-run ------------------------------------------------------------
+    flotsam.remove("killed")
+    scene = flotsam.scene(template, "killed.nml", "killed")
+    process, _, _ = interrupted_run(flotsam, checks, scene, "killed", "checkpoint_000012.h5",
+                                    lambda p: signal_ranks(p, signal.SIGKILL))
+    checks.check(process.returncode != 0, "killed: mpirun reports the killed ranks")
+    same_end_state("killed")
+
+    # --- SIGTERM to the ranks ---------------------------------------------------------------------
+    flotsam.remove("terminated")
+    scene = flotsam.scene(template, "terminated.nml", "terminated")
+    process, stderr, restart = interrupted_run(flotsam, checks, scene, "terminated", "checkpoint_000010.h5",
+                                               lambda p: signal_ranks(p, signal.SIGTERM))
+    checks.check(process.returncode == 5, "terminated: exit status 5", f"got {process.returncode}")
+    checks.check("flotsam: stopped by SIGTERM at step" in stderr and "checkpoint written" in stderr,
+                 "terminated: says where it stopped and which checkpoint it wrote", stderr[-1000:])
+    checks.check("continuing" in restart.stderr, "terminated: the restart says where it continues")
+    same_end_state("terminated")
+
+    # --- SIGTERM to mpirun, which forwards it to the ranks ----------------------------------------
+    flotsam.remove("mpirun_terminated")
+    scene = flotsam.scene(template, "mpirun_terminated.nml", "mpirun_terminated")
+    process, stderr, _ = interrupted_run(flotsam, checks, scene, "mpirun_terminated", "checkpoint_000010.h5",
+                                         lambda p: p.send_signal(signal.SIGTERM))
+    checks.check("flotsam: stopped by SIGTERM" in stderr, "mpirun_terminated: checkpoint written", stderr[-1000:])
+    same_end_state("mpirun_terminated")
+
+    # --- restart on another number of ranks --------------------------------------------------------
+    flotsam.remove("three_ranks")
+    shutil.copytree(flotsam.path("reference"), flotsam.path("three_ranks"))
+    scene = flotsam.scene(template, "three_ranks.nml", "three_ranks")
+    result = flotsam.run(scene, 3, "--restart", "three_ranks/checkpoints/checkpoint_000015.h5")
+    checks.check(result.returncode == 0, "three ranks: restart of a 2-rank checkpoint", result.stderr[-2000:])
+    rows = read_diagnostics(flotsam.path("three_ranks"))
+    checks.check(len(rows) == len(reference), "three ranks: as many rows", f"{len(rows)} against {len(reference)}")
+    checks.check(rows[-1]["step"] == reference[-1]["step"] and rows[-1]["particles"] == reference[-1]["particles"],
+                 "three ranks: same final step and particle count")
+    for column in VALUE_COLUMNS:
+        checks.close(float(rows[-1][column]), float(reference[-1][column]), 1e-10, f"three ranks: final {column}")
+
+    # --- checkpoints that must be refused -----------------------------------------------------------
+    source = flotsam.path("reference", "checkpoints", "checkpoint_000015.h5")
+    truncated = flotsam.path("truncated.h5")
+    with open(source, "rb") as f:
+        data = f.read()
+    with open(truncated, "wb") as f:
+        f.write(data[: len(data) // 2])
+    result = flotsam.run(reference_scene, RANKS, "--restart", truncated)
+    errors = error_lines(result)
+    checks.check(result.returncode == 2 and len(errors) == 1 and "truncated" in errors[0],
+                 "truncated checkpoint refused once, clearly, with status 2", f"{result.returncode}: {errors}")
+
+    other_version = flotsam.path("other_version.h5")
+    shutil.copyfile(source, other_version)
+    with h5py.File(other_version, "r+") as f:
+        f.attrs.modify("format_version", 2)
+    result = flotsam.run(reference_scene, RANKS, "--restart", other_version)
+    errors = error_lines(result)
+    checks.check(result.returncode == 2 and len(errors) == 1 and "has format version 2" in errors[0],
+                 "checkpoint of another format version refused", f"{result.returncode}: {errors}")
+    with open(flotsam.path("reference", "diagnostics.csv")) as f:
+        checks.check(f.read() == reference_text, "a refused restart leaves the run's files alone")
+
+    # --- output folders that must be refused ---------------------------------------------------------
+    result = flotsam.run(reference_scene, RANKS)
+    errors = error_lines(result)
+    checks.check(result.returncode == 3 and len(errors) == 1 and "already holds a previous run" in errors[0],
+                 "folder with a previous run refused with status 3", f"{result.returncode}: {errors}")
+    scene = flotsam.scene(template, "unwritable.nml", "/proc/flotsam_cannot_write_here")
+    result = flotsam.run(scene, RANKS)
+    errors = error_lines(result)
+    checks.check(result.returncode == 3 and len(errors) == 1 and "cannot create or write to output folder" in errors[0],
+                 "unwritable folder refused with status 3", f"{result.returncode}: {errors}")
+
+    # --overwrite: a shorter run replaces the previous one entirely
+    scene = flotsam.scene(template, "short.nml", "killed", end_time="0.02")
+    result = flotsam.run(scene, RANKS, "--overwrite")
+    checks.check(result.returncode == 0, "--overwrite replaces a previous run", result.stderr[-2000:])
+    left = sorted(os.listdir(flotsam.path("killed", "checkpoints")))
+    checks.check("checkpoint_000020.h5" not in left and len(read_diagnostics(flotsam.path("killed"))) == 3,
+                 "--overwrite leaves no file of the previous run", f"{left}")
+
+    # --- blow-up -------------------------------------------------------------------------------------
+    flotsam.remove("blow_up")
+    scene = flotsam.scene(os.path.join(scenes, "blow_up.nml"), "blow_up.nml", "blow_up")
+    result = flotsam.run(scene, RANKS)
+    errors = error_lines(result)
+    message = errors[0] if errors else ""
+    checks.check(result.returncode == 4 and len(errors) == 1, "blow-up stops the run with status 4",
+                 f"{result.returncode}: {result.stderr[-1500:]}")
+    for part in ["blew up at step 5 (t = 0.018", "s) on rank 0: particle ", "(material 'water') at x = (",
+                 "density = -", "written to blow_up/fields/fields_000002.h5 for inspection"]:
+        checks.check(part in message, f"blow-up message names: {part}", message)
+    inspection = flotsam.path("blow_up", "fields", "fields_000002.h5")
+    checks.check(os.path.exists(inspection), "blow-up: the state is written")
+    if os.path.exists(inspection):
+        with h5py.File(inspection) as f:
+            checks.check(f.attrs["step"] == 5 and min(f["particles/density"][:]) < 0,
+                         "blow-up: the inspection file holds the failing step")
+    with open(flotsam.path("blow_up", "particles.xmf")) as f:
+        checks.check("fields_000002.h5" in f.read(), "blow-up: the inspection output is in particles.xmf")
+
+    return checks.summary()
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
