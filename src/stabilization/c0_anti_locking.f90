@@ -21,6 +21,7 @@ module c0_anti_locking
       real(rp), allocatable :: average(:, :)     !< work: cell averages (kept between steps)
    contains
       procedure :: prepare => c0_prepare
+      procedure :: size_cell_arrays => c0_size_cell_arrays
       procedure :: filter_strain_rate => c0_filter_strain_rate
       procedure :: filter_stress => c0_filter_stress
    end type c0_anti_locking_t
@@ -32,14 +33,21 @@ contains
       class(c0_anti_locking_t), intent(inout) :: self
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
-      if (allocated(self%cell_mass)) then
-         if (size(self%cell_mass) /= context%grid%cell_count) deallocate (self%cell_mass, self%average)
-      end if
-      if (.not. allocated(self%cell_mass)) &
-         allocate (self%cell_mass(context%grid%cell_count), self%average(particles%n_sigma, context%grid%cell_count))
+      call self%size_cell_arrays(context%grid%cell_count, particles%n_sigma)
       call bin_cell_mass(particles, context%first, context%last, &
                          self%cell_mass)
    end subroutine c0_prepare
+
+   !> (Re)allocate the per-cell arrays when the rank's cells change.
+   subroutine c0_size_cell_arrays(self, cell_count, n_sigma)
+      class(c0_anti_locking_t), intent(inout) :: self
+      integer, intent(in) :: cell_count, n_sigma
+      if (allocated(self%cell_mass)) then
+         if (size(self%cell_mass) == cell_count) return
+         deallocate (self%cell_mass, self%average)
+      end if
+      allocate (self%cell_mass(cell_count), self%average(n_sigma, cell_count))
+   end subroutine c0_size_cell_arrays
 
    !> Filter part A: d_p := d~_c ([Y17] eq. 4, left).
    subroutine c0_filter_strain_rate(self, context, particles)

@@ -7,7 +7,7 @@ module cell_binning
    implicit none
    private
 
-   public :: bin_cell_mass, bin_cell_centre, cell_average, replace_by_cell_average
+   public :: bin_cell_mass, bin_cell_mass_and_centre, cell_average, replace_by_cell_average
 
 contains
 
@@ -23,22 +23,23 @@ contains
       end do
    end subroutine bin_cell_mass
 
-   !> Mass centre x_o^c (where m_c > 0) of the particles first..last at their current positions.
-   subroutine bin_cell_centre(particles, first, last, cell_mass, centre)
+   !> m_c and the mass centre x_o^c (where m_c > 0) of the particles first..last, in one pass.
+   subroutine bin_cell_mass_and_centre(particles, first, last, cell_mass, centre)
       type(particle_set_t), intent(in) :: particles
       integer, intent(in) :: first, last
-      real(rp), intent(in) :: cell_mass(:)
-      real(rp), intent(out) :: centre(:, :)
+      real(rp), intent(out) :: cell_mass(:), centre(:, :)
       integer :: p, c
+      cell_mass = 0.0_rp
       centre = 0.0_rp
       do p = first, last
          c = particles%cell(p)
+         cell_mass(c) = cell_mass(c) + particles%mass(p)
          centre(:, c) = centre(:, c) + particles%mass(p) * particles%x(:, p)
       end do
       do c = 1, size(cell_mass)
          if (cell_mass(c) > 0.0_rp) centre(:, c) = centre(:, c) / cell_mass(c)
       end do
-   end subroutine bin_cell_centre
+   end subroutine bin_cell_mass_and_centre
 
    !> average(:, c) = sum m_p values(:, p) / m_c over the particles first..last; values(:, p - first + 1)
    !> belongs to particle p. Cells without particles get 0.

@@ -13,7 +13,7 @@ module foal1_smoothing
    use particle_set, only: particle_set_t
    use stabilizer, only: stage_context_t
    use c0_anti_locking, only: c0_anti_locking_t
-   use cell_binning, only: bin_cell_centre, cell_average
+   use cell_binning, only: bin_cell_mass_and_centre, cell_average
    use cell_halo, only: padded_cells_t, exchange_cell_halo, halo_width
    use background_grid, only: grid_t
    use limited_flux_smoothing, only: flux_options_t, flux_workspace_t, limited_flux_increments
@@ -37,19 +37,18 @@ module foal1_smoothing
 
 contains
 
-   !> C0's cell masses plus the mass centres, at x^n.
+   !> C0's cell masses plus the mass centres, at x^n (one pass).
    subroutine foal1_prepare(self, context, particles)
       class(foal1_smoothing_t), intent(inout) :: self
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
-      call self%c0_anti_locking_t%prepare(context, particles)
+      call self%size_cell_arrays(context%grid%cell_count, particles%n_sigma)
       if (.not. same_cells(self%box, context%grid)) call self%box%init(context%grid)
       if (allocated(self%centre)) then
          if (size(self%centre, 2) /= context%grid%cell_count) deallocate (self%centre)
       end if
       if (.not. allocated(self%centre)) allocate (self%centre(context%grid%dim, context%grid%cell_count))
-      call bin_cell_centre(particles, context%first, context%last, &
-                           self%cell_mass, self%centre)
+      call bin_cell_mass_and_centre(particles, context%first, context%last, self%cell_mass, self%centre)
    end subroutine foal1_prepare
 
    !> Steps (c) to (e) for the material's particles.
@@ -98,21 +97,28 @@ contains
                                    field(row_q:, :), self%options, dq, self%workspace)
 
       ! (e) particle update
-      if (self%pressure_only .and. self%cell_averaging) &
-         call cell_average(particles, first, last, self%cell_mass, particles%sbar(:, first:last), self%average)
-      do p = first, last
-         c = particles%cell(p)
-         i = self%box%of_owned(c)
-         if (self%pressure_only) then
-            ! q = p / rho = -tr(s) / 3: its increment enters the normal components with opposite sign
+      if (self%pressure_only) then
+         ! q = p / rho = -tr(s) / 3: its increment enters the normal components with opposite sign
+         if (self%cell_averaging) &
+            call cell_average(particles, first, last, self%cell_mass, particles%sbar(:, first:last), self%average)
+         do p = first, last
+            c = particles%cell(p)
             if (self%cell_averaging) particles%sbar(:, p) = self%average(:, c)
-            particles%sbar(1:3, p) = particles%sbar(1:3, p) - dq(1, i)
-         else if (self%cell_averaging) then
-            particles%sbar(:, p) = q_cell(:, c) + dq(:, i)
-         else
-            particles%sbar(:, p) = particles%sbar(:, p) + dq(:, i)
-         end if
-      end do
+            particles%sbar(1:3, p) = particles%sbar(1:3, p) - dq(1, self%box%of_owned(c))
+         end do
+      else if (self%cell_averaging) then
+         ! q^_c = q_c + dq_c per owned cell (eq. 13), then a plain gather
+         do c = 1, context%grid%cell_count
+            if (self%cell_mass(c) > 0.0_rp) q_cell(:, c) = q_cell(:, c) + dq(:, self%box%of_owned(c))
+         end do
+         do p = first, last
+            particles%sbar(:, p) = q_cell(:, particles%cell(p))
+         end do
+      else
+         do p = first, last
+            particles%sbar(:, p) = particles%sbar(:, p) + dq(:, self%box%of_owned(particles%cell(p)))
+         end do
+      end if
       end associate
    end subroutine foal1_filter_stress
 

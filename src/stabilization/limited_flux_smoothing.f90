@@ -27,7 +27,8 @@ module limited_flux_smoothing
    real(rp), parameter :: min_centre_distance = 1.0e-3_rp
    !> Noise guard of the oscillation test [R] (algorithms.md section 3.3, step 2): a difference between
    !> neighbours smaller than this fraction of the largest |q| (any component) of the three cells counts
-   !> as zero. Without
+   !> as zero. The scale is the largest component because a component that is zero in exact arithmetic
+   !> (the shear stress of a fluid at rest) carries noise at the scale of the others. Without
    !> it, a field that is flat along an axis (a tank at rest, across its width) has its oscillation flags
    !> decided by round-off, which then opens faces with O(1) jumps at random and makes the result depend
    !> on the order of floating-point sums (for instance on the number of MPI ranks).
@@ -36,6 +37,7 @@ module limited_flux_smoothing
    !> Work arrays of limited_flux_increments, kept between calls (a step must not page in fresh memory).
    type, public :: flux_workspace_t
       logical, allocatable :: oscillating(:, :)
+      real(rp), allocatable :: scale(:)
    end type flux_workspace_t
 
    public :: limited_flux_increments
@@ -53,9 +55,9 @@ contains
       type(flux_options_t), intent(in) :: options
       real(rp), intent(out) :: dq(:, :)
       type(flux_workspace_t), intent(inout) :: workspace
-      integer :: k, nq, c, stride, along, j, i1, i2, i3, position(3)
+      integer :: k, nq, c, stride, along, j, i1, i2, i3, position(3), lo(3), hi(3)
       real(rp) :: n_faces, flux, jump, limited_jump, x_m, allowed, d_min, slope_minus(size(q, 1)), &
-                  slope_plus(size(q, 1))
+                  slope_plus(size(q, 1)), noise, left, right
       logical :: active
 
       nq = size(q, 1)
@@ -63,25 +65,47 @@ contains
       d_min = min_centre_distance * h
       dq = 0.0_rp
       if (allocated(workspace%oscillating)) then
-         if (any(shape(workspace%oscillating) /= [nq, box%count])) deallocate (workspace%oscillating)
+         if (any(shape(workspace%oscillating) /= [nq, box%count])) deallocate (workspace%oscillating, workspace%scale)
       end if
-      if (.not. allocated(workspace%oscillating)) allocate (workspace%oscillating(nq, box%count))
-      associate (oscillating => workspace%oscillating)
+      if (.not. allocated(workspace%oscillating)) &
+         allocate (workspace%oscillating(nq, box%count), workspace%scale(box%count))
+      associate (oscillating => workspace%oscillating, scale => workspace%scale)
+      ! the loops below only visit the bounding box of the existing cells (cost follows the material)
+      lo = box%n
+      hi = 1
+      c = 0
+      do i3 = 1, box%n(3)
+         do i2 = 1, box%n(2)
+            do i1 = 1, box%n(1)
+               c = c + 1
+               if (.not. exists(c)) cycle
+               position = [i1, i2, i3]
+               lo = min(lo, position)
+               hi = max(hi, position)
+               scale(c) = noise_guard * maxval(abs(q(:, c)))     ! round-off scale (see noise_guard)
+            end do
+         end do
+      end do
       do k = 1, box%dim
          stride = box%stride(k)
          ! oscillation flags (eq. 6) of every cell with both neighbours inside the padded box
-         c = 0
-         do i3 = 1, box%n(3)
-            do i2 = 1, box%n(2)
-               do i1 = 1, box%n(1)
-                  c = c + 1
+         do i3 = lo(3), hi(3)
+            do i2 = lo(2), hi(2)
+               do i1 = lo(1), hi(1)
+                  c = 1 + (i1 - 1) + (i2 - 1) * box%stride(2) + (i3 - 1) * box%stride(3)
                   if (.not. exists(c)) cycle
                   position = [i1, i2, i3]
                   along = position(k)
                   if (along == 1 .or. along == box%n(k)) then
                      oscillating(:, c) = .false.
                   else if (exists(c - stride) .and. exists(c + stride)) then
-                     call oscillation_flags(q(:, c - stride), q(:, c), q(:, c + stride), oscillating(:, c))
+                     ! eq. 6 with the noise guard: both differences above round-off and of opposite sign
+                     noise = max(scale(c - stride), scale(c), scale(c + stride))
+                     do j = 1, nq
+                        left = q(j, c) - q(j, c - stride)
+                        right = q(j, c + stride) - q(j, c)
+                        oscillating(j, c) = abs(right) > noise .and. abs(left) > noise .and. right * left < 0.0_rp
+                     end do
                   else
                      oscillating(:, c) = .false.     ! a cell missing a neighbour cannot be tested [?]
                   end if
@@ -89,11 +113,10 @@ contains
             end do
          end do
          ! faces (c, c + stride) with both cells present, at least one owned, and an oscillating cell
-         c = 0
-         do i3 = 1, box%n(3)
-            do i2 = 1, box%n(2)
-               do i1 = 1, box%n(1)
-                  c = c + 1
+         do i3 = lo(3), hi(3)
+            do i2 = lo(2), hi(2)
+               do i1 = lo(1), hi(1)
+                  c = 1 + (i1 - 1) + (i2 - 1) * box%stride(2) + (i3 - 1) * box%stride(3)
                   if (.not. exists(c)) cycle
                   position = [i1, i2, i3]
                   along = position(k)
@@ -130,21 +153,6 @@ contains
       end associate
    end subroutine limited_flux_increments
 
-   !> Eq. 6 with the noise guard: (q_r - q_c)(q_c - q_l) < 0, both differences above round-off. The
-   !> round-off scale is that of the largest component of the three cells: a component that is zero in
-   !> exact arithmetic (the shear stress of a fluid at rest) carries noise at the scale of the others.
-   pure subroutine oscillation_flags(ql, qc, qr, oscillating)
-      real(rp), intent(in) :: ql(:), qc(:), qr(:)
-      logical, intent(out) :: oscillating(:)
-      real(rp) :: noise, left, right
-      integer :: j
-      noise = noise_guard * max(maxval(abs(ql)), maxval(abs(qc)), maxval(abs(qr)))
-      do j = 1, size(qc)
-         left = qc(j) - ql(j)
-         right = qr(j) - qc(j)
-         oscillating(j) = abs(right) > noise .and. abs(left) > noise .and. right * left < 0.0_rp
-      end do
-   end subroutine oscillation_flags
 
    !> Eq. 7 slope along axis k of cell c (of a face that lies inside the padded box, so both of c's
    !> neighbours along k are inside it too): central with both neighbours, one-sided with one, else 0.

@@ -20,7 +20,7 @@ import signal
 
 import h5py
 
-from flotsam_run import Checks, Flotsam, main_arguments, read_diagnostics, signal_ranks, wait_for_file
+from flotsam_run import GRACEFUL_MPIRUN, Checks, Flotsam, main_arguments, read_diagnostics, signal_ranks, wait_for_file
 
 RANKS = 2
 VALUE_COLUMNS = ["time", "total_mass", "kinetic_energy", "fluid_volume", "h_eq", "max_speed"]
@@ -30,10 +30,10 @@ def error_lines(result):
     return [line for line in result.stderr.splitlines() if line.startswith("flotsam: error:")]
 
 
-def interrupted_run(flotsam, checks, scene, name, wait_for, interrupt):
+def interrupted_run(flotsam, checks, scene, name, wait_for, interrupt, environment=None):
     """Start a run, interrupt it once checkpoint `wait_for` exists, restart it from the latest
     checkpoint; returns (the interrupted process, its stderr, the restart's CompletedProcess)."""
-    process = flotsam.start(scene, RANKS)
+    process = flotsam.start(scene, RANKS, environment=environment)
     reached = wait_for_file(flotsam.path(name, "checkpoints", wait_for), process)
     checks.check(reached, f"{name}: the run wrote {wait_for}")
     interrupt(process)
@@ -90,7 +90,7 @@ def main():
     flotsam.remove("mpirun_terminated")
     scene = flotsam.scene(template, "mpirun_terminated.nml", "mpirun_terminated")
     process, stderr, _ = interrupted_run(flotsam, checks, scene, "mpirun_terminated", "checkpoint_000010.h5",
-                                         lambda p: p.send_signal(signal.SIGTERM))
+                                         lambda p: p.send_signal(signal.SIGTERM), GRACEFUL_MPIRUN)
     checks.check("flotsam: stopped by SIGTERM" in stderr, "mpirun_terminated: checkpoint written", stderr[-1000:])
     same_end_state("mpirun_terminated")
 

@@ -14,9 +14,11 @@ MPI_ENVIRONMENT = {
     "OMPI_ALLOW_RUN_AS_ROOT": "1",
     "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
     "OMPI_MCA_rmaps_base_oversubscribe": "1",
-    # time the ranks get after mpirun forwards a SIGTERM before it kills them (default 1 s)
-    "OMPI_MCA_odls_base_sigkill_timeout": "60",
 }
+
+#: Seconds the ranks get to write their checkpoint after mpirun forwards a SIGTERM, before it kills them
+#: (Open MPI's default is 1). It also delays the end of any job whose rank fails: use it only there.
+GRACEFUL_MPIRUN = {"OMPI_MCA_odls_base_sigkill_timeout": "60"}
 
 
 class Checks:
@@ -61,8 +63,11 @@ class Flotsam:
         with open(template) as f:
             text = f.read()
         text = re.sub(r"output_dir\s*=\s*'[^']*'", f"output_dir = '{output_dir}'", text)
+        # at the end of &run, so that they override the template's values
+        start = text.index("&run")
+        end = text.index("\n/", start)
         extra = "".join(f"\n   {key} = {value}" for key, value in run_values.items())
-        text = re.sub(r"&run", "&run" + extra, text, count=1)
+        text = text[:end] + extra + text[end:]
         path = os.path.join(self.workdir, name)
         with open(path, "w") as f:
             f.write(text)
@@ -76,8 +81,10 @@ class Flotsam:
         return subprocess.run(self.command(scene, ranks, *arguments), cwd=self.workdir, env=self.environment,
                               capture_output=True, text=True, timeout=timeout)
 
-    def start(self, scene, ranks, *arguments):
-        return subprocess.Popen(self.command(scene, ranks, *arguments), cwd=self.workdir, env=self.environment,
+    def start(self, scene, ranks, *arguments, environment=None):
+        """Start a run in the background (extra environment variables in `environment`)."""
+        return subprocess.Popen(self.command(scene, ranks, *arguments), cwd=self.workdir,
+                                env=dict(self.environment, **(environment or {})),
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
     def path(self, *parts):
@@ -138,5 +145,5 @@ def main_arguments():
     return sys.argv[1], sys.argv[2], os.path.abspath(sys.argv[3]), sys.argv[4:]
 
 
-__all__ = ["Checks", "Flotsam", "child_pids", "wait_for_file", "signal_ranks", "read_diagnostics", "signal",
+__all__ = ["GRACEFUL_MPIRUN", "Checks", "Flotsam", "child_pids", "wait_for_file", "signal_ranks", "read_diagnostics", "signal",
            "main_arguments"]
