@@ -1,17 +1,29 @@
-!> Benchmark driver: `mpirun -np N flotsam_bench scene.nml steps`. Runs a scene for a fixed number of
-!> steps without output and prints one line of figures (scripts/bench collects them):
+!> Benchmark driver: `mpirun -np N flotsam_bench scene.nml steps [output]`. Runs a scene for a fixed
+!> number of steps without output and prints one line of figures (scripts/bench collects them):
 !>   dim ranks particles steps seconds particle_steps_per_s_per_core bytes_per_particle
 !> Memory per particle is the growth of the resident set from before the solver is built to after the
 !> timed steps, divided by the rank's particles (rank 0's view).
+!> With `output`, it then times the output of the final state into the scene's output_dir (replaced):
+!> one fields file (particles and grid, the mean of 3 writes), one checkpoint, and the per-step health
+!> check of the time loop (the mean of 100 calls), and prints a second line:
+!>   output dim ranks particles seconds_per_step fields_seconds checkpoint_seconds health_check_seconds
 program flotsam_bench
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use kinds, only: rp, i8
-   use mpi_f08, only: MPI_Init, MPI_Finalize, MPI_Comm_rank, MPI_Comm_size, MPI_Barrier, MPI_Wtime, MPI_COMM_WORLD
+   use mpi_f08, only: MPI_Init, MPI_Finalize, MPI_Comm_rank, MPI_Comm_size, MPI_Barrier, MPI_Wtime, MPI_COMM_WORLD, &
+                      MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER, MPI_MAX
    use error_status, only: status_t
    use scene_description, only: scene_t
    use scene_reader, only: read_scene
    use mpm_solver, only: solver_t
    use run_diagnostics, only: diagnostics_t
+   use output_directory, only: prepare_output_directory
+   use run_progress, only: run_progress_t
+   use xdmf_writer, only: output_entry_t
+   use field_output, only: write_fields
+   use checkpoint, only: write_checkpoint
+   use health_check, only: particles_healthy
+   use simulation, only: blow_up_speed
    implicit none
 
    type(scene_t) :: scene
@@ -25,8 +37,8 @@ program flotsam_bench
    call MPI_Init()
    call MPI_Comm_rank(MPI_COMM_WORLD, rank)
    call MPI_Comm_size(MPI_COMM_WORLD, n_ranks)
-   if (command_argument_count() /= 2) then
-      if (rank == 0) write (error_unit, '(a)') 'usage: mpirun -np N flotsam_bench <scene.nml> <steps>'
+   if (command_argument_count() < 2 .or. command_argument_count() > 3) then
+      if (rank == 0) write (error_unit, '(a)') 'usage: mpirun -np N flotsam_bench <scene.nml> <steps> [output]'
       call MPI_Finalize()
       error stop 2
    end if
@@ -64,10 +76,55 @@ program flotsam_bench
    if (rank == 0) write (output_unit, '(i0,1x,i0,1x,i0,1x,i0,1x,es12.5,1x,es12.5,1x,f10.1)') scene%grid%dim, n_ranks, &
       diag%particles, steps, t1 - t0, real(diag%particles, rp) * steps / ((t1 - t0) * n_ranks), &
       (rss_after - rss_before) / max(1, solver%particles%count)
+   if (command_argument_count() == 3) call time_output((t1 - t0) / steps)
    call solver%free()
    call MPI_Finalize()
 
 contains
+
+   !> Time the output of the current state: fields file, checkpoint, health check (see the header).
+   subroutine time_output(step_seconds)
+      real(rp), intent(in) :: step_seconds
+      type(run_progress_t) :: progress
+      type(output_entry_t) :: entry
+      character(len=:), allocatable :: path
+      real(rp) :: fields_seconds, checkpoint_seconds, health_seconds, speed_limit
+      integer :: k, flags(3)
+      logical :: healthy
+      integer, parameter :: writes = 3, checks = 100
+
+      call prepare_output_directory(scene%run%output_dir, .true., MPI_COMM_WORLD, status)
+      if (.not. status%ok) call bench_failure()
+      call MPI_Barrier(MPI_COMM_WORLD)
+      t0 = MPI_Wtime()
+      do k = 1, writes
+         call write_fields(solver, trim(scene%run%output_dir), k - 1, entry, status)
+      end do
+      call MPI_Barrier(MPI_COMM_WORLD)
+      fields_seconds = (MPI_Wtime() - t0) / writes
+      t0 = MPI_Wtime()
+      call write_checkpoint(solver, progress, trim(scene%run%output_dir), 1, path, status)
+      call MPI_Barrier(MPI_COMM_WORLD)
+      checkpoint_seconds = MPI_Wtime() - t0
+      if (.not. status%ok) call bench_failure()
+      speed_limit = blow_up_speed(solver)
+      t0 = MPI_Wtime()
+      do k = 1, checks         ! as in the time loop: the local check and the agreement on 3 flags
+         healthy = particles_healthy(solver%particles, speed_limit)
+         flags = merge(0, 1, healthy)
+         call MPI_Allreduce(MPI_IN_PLACE, flags, 3, MPI_INTEGER, MPI_MAX, MPI_COMM_WORLD)
+      end do
+      health_seconds = (MPI_Wtime() - t0) / checks
+      if (.not. healthy) health_seconds = -health_seconds     ! a blown-up bench state: say so
+      if (rank == 0) write (output_unit, '(a,1x,i0,1x,i0,1x,i0,4(1x,es12.5))') 'output', scene%grid%dim, n_ranks, &
+         diag%particles, step_seconds, fields_seconds, checkpoint_seconds, health_seconds
+   end subroutine time_output
+
+   subroutine bench_failure()
+      if (rank == 0) write (error_unit, '(a)') 'flotsam_bench: error: '//trim(status%message)
+      call MPI_Finalize()
+      error stop 2
+   end subroutine bench_failure
 
    !> Resident set size of this process [bytes], from /proc/self/status (0 where unavailable).
    real(rp) function resident_bytes()

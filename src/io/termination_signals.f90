@@ -1,6 +1,8 @@
-!> SIGTERM and SIGINT, what a batch scheduler (or Ctrl-C) sends before ending a job: the handler only
-!> records the signal, and the time loop checkpoints and stops at the end of the step in which all
-!> ranks have seen it. A second signal of the same kind ends the process at once (default action).
+!> SIGTERM and SIGINT, what a batch scheduler (or Ctrl-C) sends before ending a job, and SIGUSR1, which
+!> mpirun forwards to every rank at once (Open MPI turns a SIGTERM to mpirun into a SIGTERM to the
+!> ranks only after a delay, and sometimes not at all): the handler only records the signal, and the
+!> time loop checkpoints and stops at the end of the step in which all ranks have seen it. A second
+!> signal of the same kind ends the process at once (default action).
 !>
 !> The handler is installed through the C library's signal() (bind(C)), since -std=f2018 has no
 !> SIGNAL intrinsic. Signal numbers are those of Linux (and every common POSIX system).
@@ -9,7 +11,7 @@ module termination_signals
    implicit none
    private
 
-   integer(c_int), parameter, public :: sigint = 2, sigterm = 15
+   integer(c_int), parameter, public :: sigint = 2, sigusr1 = 10, sigterm = 15
 
    public :: install_termination_handlers, received_termination_signal, signal_name
 
@@ -27,12 +29,13 @@ module termination_signals
 
 contains
 
-   !> Record SIGTERM and SIGINT from now on (and forget any signal recorded before).
+   !> Record SIGTERM, SIGINT and SIGUSR1 from now on (and forget any signal recorded before).
    subroutine install_termination_handlers()
       type(c_funptr) :: previous
       received = 0
       previous = c_signal(sigterm, c_funloc(on_termination_signal))
       previous = c_signal(sigint, c_funloc(on_termination_signal))
+      previous = c_signal(sigusr1, c_funloc(on_termination_signal))
    end subroutine install_termination_handlers
 
    !> The signal received since the handlers were installed, 0 if none.
@@ -40,7 +43,7 @@ contains
       received_termination_signal = received
    end function received_termination_signal
 
-   !> 'SIGTERM', 'SIGINT' or 'signal <n>'.
+   !> 'SIGTERM', 'SIGINT', 'SIGUSR1' or 'signal <n>'.
    pure function signal_name(signum) result(name)
       integer, intent(in) :: signum
       character(len=:), allocatable :: name
@@ -50,6 +53,8 @@ contains
          name = 'SIGTERM'
       case (sigint)
          name = 'SIGINT'
+      case (sigusr1)
+         name = 'SIGUSR1'
       case default
          write (number, '(i0)') signum
          name = 'signal '//trim(number)

@@ -28,13 +28,15 @@ contains
       type(particle_set_t), intent(in) :: particles
       integer, intent(in) :: first, last
       real(rp), intent(out) :: cell_mass(:), centre(:, :)
-      integer :: p, c
+      integer :: p, c, k
       cell_mass = 0.0_rp
       centre = 0.0_rp
       do p = first, last
          c = particles%cell(p)
          cell_mass(c) = cell_mass(c) + particles%mass(p)
-         centre(:, c) = centre(:, c) + particles%mass(p) * particles%x(:, p)
+         do k = 1, size(centre, 1)
+            centre(k, c) = centre(k, c) + particles%mass(p) * particles%x(k, p)
+         end do
       end do
       do c = 1, size(cell_mass)
          if (cell_mass(c) > 0.0_rp) centre(:, c) = centre(:, c) / cell_mass(c)

@@ -19,7 +19,8 @@ module test_stabilization_consistency
    implicit none
    private
 
-   public :: test_random_field_rank_invariance, test_checkerboard_rank_invariance, test_random_field_3d_rank_invariance, &
+   public :: test_conservation_per_material, test_random_field_rank_invariance, test_checkerboard_rank_invariance, &
+             test_random_field_3d_rank_invariance, &
              test_gamma_zero_is_c0, test_c0_is_one_point_quadrature_2d
 
    integer, parameter :: random_field = 1, checkerboard = 2
@@ -138,6 +139,61 @@ contains
       call MPI_Allreduce(MPI_IN_PLACE, field, size(field), MPI_DOUBLE_PRECISION, MPI_SUM, comm)
       call solver%free()
    end subroutine smoothed_field
+
+   !> Two fluids side by side and mixed in some cells, each smoothed by its own FOAL1: the sum of m_p s_p
+   !> of each material is unchanged by the stress stage (cell averaging and fluxes), to round-off.
+   subroutine test_conservation_per_material(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(solver_t), target :: solver
+      type(scene_t) :: scene
+      type(status_t) :: status
+      type(stage_context_t) :: context
+      real(rp) :: before(6, 2), after(6, 2), scale(2)
+      integer :: m, p
+      scene = block_scene(2, 'FOAL1')
+      scene%materials = [scene%materials(1), scene%materials(1)]
+      scene%materials(2)%name = 'oil'
+      scene%materials(2)%density = 800.0_rp
+      scene%bodies(1)%upper(1) = 1.3_rp
+      call add_body(scene, 2, [1.25_rp, 0.0_rp, 0.0_rp], [2.3_rp, 1.2_rp, 0.0_rp], 3, .true., 1.2_rp)
+      call solver%init(scene, comm, status)
+      call assertTrue(status%ok, 'solver init: '//trim(status%message))
+      do p = 1, solver%particles%count
+         solver%particles%sbar(:, p) = value_of(solver%particles%id(p) + 1000 * solver%particles%material(p), &
+                                                [0, 0, 0], random_field, 4)
+      end do
+      context%domain => solver%domain
+      context%grid => solver%grid
+      before = material_sums(solver, comm)
+      do m = 1, 2
+         context%first = solver%particles%material_first(m)
+         context%last = solver%particles%material_last(m)
+         call solver%schemes(m)%scheme%prepare(context, solver%particles)
+         call solver%schemes(m)%scheme%filter_stress(context, solver%particles)
+      end do
+      after = material_sums(solver, comm)
+      do m = 1, 2
+         scale(m) = sum(abs(before(5:6, m)))
+         call assertEqual(before(1:4, m), after(1:4, m), 1.0e-13_rp * scale(m), 'sum m s conserved per material')
+         call assertTrue(maxval(abs(after(5:6, m) - before(5:6, m))) < scale(m), 'scale unchanged')
+      end do
+      call solver%free()
+   end subroutine test_conservation_per_material
+
+   !> Rows 1-4: sum m_p s_p per component; rows 5-6: sum m_p |s_p| (a scale); one column per material.
+   function material_sums(solver, comm) result(sums)
+      type(solver_t), intent(in) :: solver
+      type(MPI_Comm), intent(in) :: comm
+      real(rp) :: sums(6, 2)
+      integer :: p, m
+      sums = 0.0_rp
+      do p = 1, solver%particles%count
+         m = solver%particles%material(p)
+         sums(1:4, m) = sums(1:4, m) + solver%particles%mass(p) * solver%particles%sbar(:, p)
+         sums(5, m) = sums(5, m) + solver%particles%mass(p) * sum(abs(solver%particles%sbar(:, p)))
+      end do
+      call MPI_Allreduce(MPI_IN_PLACE, sums, 12, MPI_DOUBLE_PRECISION, MPI_SUM, comm)
+   end function material_sums
 
    !> FOAL1 with gamma_max = 0 and C0 run 50 steps of a collapsing block to bitwise the same state.
    subroutine test_gamma_zero_is_c0(comm)

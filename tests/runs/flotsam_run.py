@@ -16,9 +16,6 @@ MPI_ENVIRONMENT = {
     "OMPI_MCA_rmaps_base_oversubscribe": "1",
 }
 
-#: Seconds the ranks get to write their checkpoint after mpirun forwards a SIGTERM, before it kills them
-#: (Open MPI's default is 1). It also delays the end of any job whose rank fails: use it only there.
-GRACEFUL_MPIRUN = {"OMPI_MCA_odls_base_sigkill_timeout": "60"}
 
 
 class Checks:
@@ -81,10 +78,9 @@ class Flotsam:
         return subprocess.run(self.command(scene, ranks, *arguments), cwd=self.workdir, env=self.environment,
                               capture_output=True, text=True, timeout=timeout)
 
-    def start(self, scene, ranks, *arguments, environment=None):
-        """Start a run in the background (extra environment variables in `environment`)."""
-        return subprocess.Popen(self.command(scene, ranks, *arguments), cwd=self.workdir,
-                                env=dict(self.environment, **(environment or {})),
+    def start(self, scene, ranks, *arguments):
+        """Start a run in the background."""
+        return subprocess.Popen(self.command(scene, ranks, *arguments), cwd=self.workdir, env=self.environment,
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
     def path(self, *parts):
@@ -145,5 +141,5 @@ def main_arguments():
     return sys.argv[1], sys.argv[2], os.path.abspath(sys.argv[3]), sys.argv[4:]
 
 
-__all__ = ["GRACEFUL_MPIRUN", "Checks", "Flotsam", "child_pids", "wait_for_file", "signal_ranks", "read_diagnostics", "signal",
+__all__ = ["Checks", "Flotsam", "child_pids", "wait_for_file", "signal_ranks", "read_diagnostics", "signal",
            "main_arguments"]

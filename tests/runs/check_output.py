@@ -1,0 +1,133 @@
+#!/usr/bin/python3
+"""The HDF5 fields files and XDMF time series of a run, read back with h5py and meshio and checked
+against the run's own diagnostics.csv: one fields file per diagnostics row at the same time and step,
+particle counts, total mass, kinetic energy, fluid volume and maximum speed recomputed from the
+particle fields, unique ids, positions in the world frame, consistent stress fields, a grid whose nodal
+mass sums to the total mass, and the XDMF files listing every output time. The 2-D scene runs on 3 ranks
+of which one holds no particle; the 3-D scene on 2 ranks. Also runs scripts/plot_diagnostics.py.
+
+usage: check_output.py <flotsam> <mpiexec> <tests/runs/scenes> <scripts folder>"""
+
+import os
+import subprocess
+import sys
+from xml.etree import ElementTree
+
+import h5py
+import meshio
+import numpy as np
+
+from flotsam_run import Checks, Flotsam, main_arguments, read_diagnostics
+
+
+def check_run(checks, flotsam, scenes, name, ranks, fluid_materials, empty_rank=None):
+    flotsam.remove(name)
+    scene = flotsam.scene(os.path.join(scenes, name + ".nml"), name + ".nml", name)
+    result = flotsam.run(scene, ranks)
+    if not checks.check(result.returncode == 0, f"{name}: run on {ranks} ranks", result.stderr[-2000:]):
+        return
+    rows = read_diagnostics(flotsam.path(name))
+    directory = flotsam.path(name)
+    with open(scene) as f:
+        text = f.read()
+    dim = 3 if "dim = 3" in text else 2
+
+    for index, row in enumerate(rows):
+        label = f"{name} output {index}"
+        path = os.path.join(directory, "fields", f"fields_{index:06d}.h5")
+        if not checks.check(os.path.exists(path), f"{label}: fields file exists"):
+            continue
+        with h5py.File(path) as f:
+            checks.close(f.attrs["time"], float(row["time"]), 1e-15, f"{label}: time")
+            checks.check(int(f.attrs["step"]) == int(row["step"]), f"{label}: step")
+            p = f["particles"]
+            n = int(row["particles"])
+            checks.check(p["position"].shape == (n, 3) and p["stress"].shape == (n, 9),
+                         f"{label}: {n} particles with 3 coordinates and 9 stress components",
+                         f"{p['position'].shape}, {p['stress'].shape}")
+            mass, velocity, volume, density = p["mass"][:], p["velocity"][:], p["volume"][:], p["density"][:]
+            material, ids, rank = p["material"][:], p["id"][:], p["rank"][:]
+            checks.close(mass.sum(), float(row["total_mass"]), 1e-12, f"{label}: total mass")
+            checks.close(0.5 * (mass * (velocity ** 2).sum(axis=1)).sum(), float(row["kinetic_energy"]), 1e-10,
+                         f"{label}: kinetic energy")
+            fluid = np.isin(material, fluid_materials)
+            checks.close(volume[fluid].sum(), float(row["fluid_volume"]), 1e-10, f"{label}: fluid volume")
+            checks.close(np.sqrt((velocity ** 2).sum(axis=1).max()), float(row["max_speed"]), 1e-12,
+                         f"{label}: max speed")
+            checks.check(np.allclose(volume, mass / density, rtol=1e-14), f"{label}: volume = mass / density")
+            checks.check(np.array_equal(np.sort(ids), np.arange(n)), f"{label}: ids unique, 0 .. N-1")
+            checks.check(np.array_equal(p["connectivity"][:], np.arange(n)), f"{label}: connectivity 0 .. N-1")
+            if empty_rank is not None:
+                checks.check(empty_rank not in rank and set(rank) <= set(range(ranks)),
+                             f"{label}: rank {empty_rank} held no particle and still wrote", f"{set(rank)}")
+            stress = p["stress"][:].reshape(n, 3, 3)
+            checks.check(np.allclose(stress, stress.transpose(0, 2, 1), rtol=0, atol=0), f"{label}: stress symmetric")
+            checks.check(np.allclose(p["mean_stress"][:], np.trace(stress, axis1=1, axis2=2) / 3, rtol=1e-13,
+                                     atol=1e-9), f"{label}: mean stress = trace / 3")
+            position = p["position"][:]
+            if dim == 2:
+                checks.check(not position[:, 2].any() and not velocity[:, 2].any() and
+                             not stress[:, 2, 0:2].any(), f"{label}: z = 0 in 2-D")
+            g = f["grid"]
+            checks.close(g["node/mass"][:].sum(), float(row["total_mass"]), 1e-10, f"{label}: grid mass")
+            node_dims = g["node/mass"].shape
+            checks.check(g["node/velocity"].shape == node_dims + (3,), f"{label}: nodal velocity shape")
+            densities = [k for k in g["cell"] if k.startswith("density_")]
+            for key in densities:
+                cells = g["cell"][key][:]
+                checks.check(cells.shape == tuple(max(d - 1, 1) for d in node_dims),
+                             f"{label}: {key} on the cells", f"{cells.shape} for nodes {node_dims}")
+                filled = cells[np.isfinite(cells)]
+                checks.check(filled.size > 0 and np.all(filled > 0), f"{label}: {key} positive where present")
+
+    # the particle time series, as meshio reads it
+    with meshio.xdmf.TimeSeriesReader(os.path.join(directory, "particles.xmf")) as reader:
+        points, cells = reader.read_points_cells()
+        times = [reader.read_data(k)[0] for k in range(reader.num_steps)]
+        checks.check(reader.num_steps == len(rows), f"{name} particles.xmf: one step per diagnostics row",
+                     f"{reader.num_steps} steps, {len(rows)} rows")
+        checks.check(np.allclose(times, [float(r["time"]) for r in rows], rtol=1e-15, atol=0),
+                     f"{name} particles.xmf: the diagnostics times")
+        checks.check(points.shape == (int(rows[0]["particles"]), 3) and cells[0].type == "vertex",
+                     f"{name} particles.xmf: point cloud of vertices", f"{points.shape}, {cells[0].type}")
+        _, point_data, _ = reader.read_data(reader.num_steps - 1)
+        checks.check({"velocity", "stress", "mean_stress", "density", "id", "rank"} <= set(point_data),
+                     f"{name} particles.xmf: arrays", f"{sorted(point_data)}")
+
+    # the grid time series (a structured mesh, which meshio does not read): times and data items
+    grids = ElementTree.parse(os.path.join(directory, "grid.xmf")).getroot().findall(".//Grid[@GridType='Uniform']")
+    times = [float(g.find("Time").get("Value")) for g in grids]
+    checks.check(np.allclose(times, [float(r["time"]) for r in rows], rtol=1e-15, atol=0),
+                 f"{name} grid.xmf: one grid per diagnostics time", f"{times}")
+    shapes_agree = True
+    for g in grids:
+        for item in g.iter("DataItem"):
+            if item.get("Format") != "HDF":
+                continue
+            file, dataset = item.text.split(":")
+            with h5py.File(os.path.join(directory, file)) as f:
+                shapes_agree &= f[dataset].shape == tuple(int(d) for d in item.get("Dimensions").split())
+    checks.check(shapes_agree, f"{name} grid.xmf: every data item has the shape of its dataset")
+
+
+def main():
+    flotsam_path, mpiexec, scenes, rest = main_arguments()
+    checks = Checks()
+    flotsam = Flotsam(flotsam_path, mpiexec, "output")
+    check_run(checks, flotsam, scenes, "two_materials_2d", 3, fluid_materials=[1], empty_rank=2)
+    check_run(checks, flotsam, scenes, "column_3d", 2, fluid_materials=[1])
+
+    # the matplotlib script plots the diagnostics of a run
+    if rest:
+        picture = flotsam.path("diagnostics.png")
+        if os.path.exists(picture):
+            os.remove(picture)
+        result = subprocess.run([sys.executable, os.path.join(rest[0], "plot_diagnostics.py"),
+                                 flotsam.path("two_materials_2d"), "-o", picture], capture_output=True, text=True)
+        checks.check(result.returncode == 0 and os.path.getsize(picture) > 10000,
+                     "plot_diagnostics.py draws the diagnostics", result.stderr[-1000:])
+    return checks.summary()
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
