@@ -12,6 +12,7 @@ module xdmf_writer
    use error_status, only: status_t
    use file_system, only: rename_path
    use output_layout, only: fields_file, temporary_suffix
+   use input_text, only: int_text, real_text
    implicit none
    private
 
@@ -185,30 +186,14 @@ contains
          number_type = 'Float'
       end if
       text = '<DataItem Dimensions="'//dims//'" NumberType="'//number_type//'" Precision="'// &
-             int_text(int(precision, i8))//'" Format="HDF">'//location//'</DataItem>'
+             int_text(precision)//'" Format="HDF">'//location//'</DataItem>'
    end function data_item
 
    !> "nz ny nx" of the counts n(3) along x, y, z.
    pure function dims_text(n) result(text)
       integer, intent(in) :: n(3)
       character(len=:), allocatable :: text
-      text = int_text(int(n(3), i8))//' '//int_text(int(n(2), i8))//' '//int_text(int(n(1), i8))
+      text = int_text(n(3))//' '//int_text(n(2))//' '//int_text(n(1))
    end function dims_text
 
-   pure function int_text(value) result(text)
-      integer(i8), intent(in) :: value
-      character(len=:), allocatable :: text
-      character(len=24) :: buffer
-      write (buffer, '(i0)') value
-      text = trim(buffer)
-   end function int_text
-
-   !> A real with 17 significant digits: reads back as the same value.
-   pure function real_text(value) result(text)
-      real(rp), intent(in) :: value
-      character(len=:), allocatable :: text
-      character(len=40) :: buffer
-      write (buffer, '(es24.16e3)') value
-      text = trim(adjustl(buffer))
-   end function real_text
 end module xdmf_writer

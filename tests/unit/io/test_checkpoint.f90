@@ -21,7 +21,7 @@ module test_checkpoint
    implicit none
    private
 
-   public :: test_restart_on_same_ranks_is_bitwise, test_restart_on_other_rank_count, &
+   public :: test_restart_on_same_ranks_is_bitwise, test_restart_with_foal1_is_bitwise, test_restart_on_other_rank_count, &
              test_checkpoint_of_other_scene_is_refused, test_other_format_version_is_refused, &
              test_only_newest_checkpoints_are_kept
 
@@ -70,7 +70,21 @@ contains
 
    subroutine test_restart_on_same_ranks_is_bitwise(comm)
       type(MPI_Comm), intent(in) :: comm
+      call check_bitwise_restart(comm, column_scene('same_ranks'))
+   end subroutine test_restart_on_same_ranks_is_bitwise
+
+   !> The same with the FOAL1 smoothing, whose schemes keep work arrays between steps.
+   subroutine test_restart_with_foal1_is_bitwise(comm)
+      type(MPI_Comm), intent(in) :: comm
       type(scene_t) :: scene
+      scene = column_scene('foal1')
+      scene%materials(1)%stabilization = 'FOAL1'
+      call check_bitwise_restart(comm, scene)
+   end subroutine test_restart_with_foal1_is_bitwise
+
+   subroutine check_bitwise_restart(comm, scene)
+      type(MPI_Comm), intent(in) :: comm
+      type(scene_t), intent(in) :: scene
       type(solver_t) :: uninterrupted, restarted
       type(run_progress_t) :: progress
       type(status_t) :: status
@@ -78,7 +92,6 @@ contains
       character(len=:), allocatable :: path
       integer :: step, n
 
-      scene = column_scene('same_ranks')
       call run_with_checkpoint(scene, comm, uninterrupted, path)
       call restarted%init(scene, comm, status, seed_particles=.false.)
       call read_checkpoint(path, scene, restarted, progress, status)
@@ -112,7 +125,7 @@ contains
       end if
       call uninterrupted%free()
       call restarted%free()
-   end subroutine test_restart_on_same_ranks_is_bitwise
+   end subroutine check_bitwise_restart
 
    !> Written on all ranks of comm, continued on one rank fewer.
    subroutine test_restart_on_other_rank_count(comm)
