@@ -68,57 +68,57 @@ contains
 
       ! (c) cell averages of q on the owned cells
       associate (q_cell => self%q_cell, field => self%field, dq => self%dq, exists => self%exists)
-      if (self%pressure_only) then
-         allocate (q(nq, max(0, last - first + 1)))
-         do p = first, last
-            q(1, p - first + 1) = -(particles%sbar(1, p) + particles%sbar(2, p) + particles%sbar(3, p)) / 3.0_rp
+         if (self%pressure_only) then
+            allocate (q(nq, max(0, last - first + 1)))
+            do p = first, last
+               q(1, p - first + 1) = -(particles%sbar(1, p) + particles%sbar(2, p) + particles%sbar(3, p)) / 3.0_rp
+            end do
+            call cell_average(particles, first, last, self%cell_mass, q, q_cell)
+         else
+            call cell_average(particles, first, last, self%cell_mass, particles%sbar(:, first:last), q_cell)
+         end if
+
+         ! padded cell field: exists, m_c, x_o^c, q_c; ghost layers from the neighbours (collective)
+         row_q = 3 + dim
+         field(1, :) = 0.0_rp      ! "exists"; the other rows are read only where it is set
+         do c = 1, context%grid%cell_count
+            if (self%cell_mass(c) <= 0.0_rp) cycle
+            i = self%box%of_owned(c)
+            field(1, i) = 1.0_rp
+            field(2, i) = self%cell_mass(c)
+            field(3:2 + dim, i) = self%centre(:, c)
+            field(row_q:, i) = q_cell(:, c)
          end do
-         call cell_average(particles, first, last, self%cell_mass, q, q_cell)
-      else
-         call cell_average(particles, first, last, self%cell_mass, particles%sbar(:, first:last), q_cell)
-      end if
+         call exchange_cell_halo(context%domain, context%grid, self%box, field)
+         exists = field(1, :) > 0.5_rp
 
-      ! padded cell field: exists, m_c, x_o^c, q_c; ghost layers from the neighbours (collective)
-      row_q = 3 + dim
-      field(1, :) = 0.0_rp      ! "exists"; the other rows are read only where it is set
-      do c = 1, context%grid%cell_count
-         if (self%cell_mass(c) <= 0.0_rp) cycle
-         i = self%box%of_owned(c)
-         field(1, i) = 1.0_rp
-         field(2, i) = self%cell_mass(c)
-         field(3:2 + dim, i) = self%centre(:, c)
-         field(row_q:, i) = q_cell(:, c)
-      end do
-      call exchange_cell_halo(context%domain, context%grid, self%box, field)
-      exists = field(1, :) > 0.5_rp
-
-      ! (d) limited face fluxes
-      call limited_flux_increments(self%box, context%grid%h, exists, field(2, :), field(3:2 + dim, :), &
+         ! (d) limited face fluxes
+         call limited_flux_increments(self%box, context%grid%h, exists, field(2, :), field(3:2 + dim, :), &
                                    field(row_q:, :), self%options, dq, self%workspace)
 
-      ! (e) particle update
-      if (self%pressure_only) then
-         ! q = p / rho = -tr(s) / 3: its increment enters the normal components with opposite sign
-         if (self%cell_averaging) &
+         ! (e) particle update
+         if (self%pressure_only) then
+            ! q = p / rho = -tr(s) / 3: its increment enters the normal components with opposite sign
+            if (self%cell_averaging) &
             call cell_average(particles, first, last, self%cell_mass, particles%sbar(:, first:last), self%average)
-         do p = first, last
-            c = particles%cell(p)
-            if (self%cell_averaging) particles%sbar(:, p) = self%average(:, c)
-            particles%sbar(1:3, p) = particles%sbar(1:3, p) - dq(1, self%box%of_owned(c))
-         end do
-      else if (self%cell_averaging) then
-         ! q^_c = q_c + dq_c per owned cell (eq. 13), then a plain gather
-         do c = 1, context%grid%cell_count
-            if (self%cell_mass(c) > 0.0_rp) q_cell(:, c) = q_cell(:, c) + dq(:, self%box%of_owned(c))
-         end do
-         do p = first, last
-            particles%sbar(:, p) = q_cell(:, particles%cell(p))
-         end do
-      else
-         do p = first, last
-            particles%sbar(:, p) = particles%sbar(:, p) + dq(:, self%box%of_owned(particles%cell(p)))
-         end do
-      end if
+            do p = first, last
+               c = particles%cell(p)
+               if (self%cell_averaging) particles%sbar(:, p) = self%average(:, c)
+               particles%sbar(1:3, p) = particles%sbar(1:3, p) - dq(1, self%box%of_owned(c))
+            end do
+         else if (self%cell_averaging) then
+            ! q^_c = q_c + dq_c per owned cell (eq. 13), then a plain gather
+            do c = 1, context%grid%cell_count
+               if (self%cell_mass(c) > 0.0_rp) q_cell(:, c) = q_cell(:, c) + dq(:, self%box%of_owned(c))
+            end do
+            do p = first, last
+               particles%sbar(:, p) = q_cell(:, particles%cell(p))
+            end do
+         else
+            do p = first, last
+               particles%sbar(:, p) = particles%sbar(:, p) + dq(:, self%box%of_owned(particles%cell(p)))
+            end do
+         end if
       end associate
    end subroutine foal1_filter_stress
 

@@ -70,86 +70,86 @@ contains
       if (.not. allocated(workspace%oscillating)) &
          allocate (workspace%oscillating(nq, box%count), workspace%scale(box%count))
       associate (oscillating => workspace%oscillating, scale => workspace%scale)
-      ! the loops below only visit the bounding box of the existing cells (cost follows the material)
-      lo = box%n
-      hi = 1
-      c = 0
-      do i3 = 1, box%n(3)
-         do i2 = 1, box%n(2)
-            do i1 = 1, box%n(1)
-               c = c + 1
-               if (.not. exists(c)) cycle
-               position = [i1, i2, i3]
-               lo = min(lo, position)
-               hi = max(hi, position)
-               scale(c) = noise_guard * maxval(abs(q(:, c)))     ! round-off scale (see noise_guard)
-            end do
-         end do
-      end do
-      do k = 1, box%dim
-         stride = box%stride(k)
-         ! oscillation flags (eq. 6) of every cell with both neighbours inside the padded box
-         do i3 = lo(3), hi(3)
-            do i2 = lo(2), hi(2)
-               do i1 = lo(1), hi(1)
-                  c = 1 + (i1 - 1) + (i2 - 1) * box%stride(2) + (i3 - 1) * box%stride(3)
+         ! the loops below only visit the bounding box of the existing cells (cost follows the material)
+         lo = box%n
+         hi = 1
+         c = 0
+         do i3 = 1, box%n(3)
+            do i2 = 1, box%n(2)
+               do i1 = 1, box%n(1)
+                  c = c + 1
                   if (.not. exists(c)) cycle
                   position = [i1, i2, i3]
-                  along = position(k)
-                  if (along == 1 .or. along == box%n(k)) then
-                     oscillating(:, c) = .false.
-                  else if (exists(c - stride) .and. exists(c + stride)) then
-                     ! eq. 6 with the noise guard: both differences above round-off and of opposite sign
-                     noise = max(scale(c - stride), scale(c), scale(c + stride))
-                     do j = 1, nq
-                        left = q(j, c) - q(j, c - stride)
-                        right = q(j, c + stride) - q(j, c)
-                        oscillating(j, c) = abs(right) > noise .and. abs(left) > noise .and. right * left < 0.0_rp
-                     end do
-                  else
-                     oscillating(:, c) = .false.     ! a cell missing a neighbour cannot be tested [?]
-                  end if
+                  lo = min(lo, position)
+                  hi = max(hi, position)
+                  scale(c) = noise_guard * maxval(abs(q(:, c)))     ! round-off scale (see noise_guard)
                end do
             end do
          end do
-         ! faces (c, c + stride) with both cells present, at least one owned, and an oscillating cell
-         do i3 = lo(3), hi(3)
-            do i2 = lo(2), hi(2)
-               do i1 = lo(1), hi(1)
-                  c = 1 + (i1 - 1) + (i2 - 1) * box%stride(2) + (i3 - 1) * box%stride(3)
-                  if (.not. exists(c)) cycle
-                  position = [i1, i2, i3]
-                  along = position(k)
-                  if (along < 2 .or. along > box%n(k) - 2) cycle
-                  if (.not. exists(c + stride)) cycle
-                  if (.not. (box%owned(c) .or. box%owned(c + stride))) cycle
-                  if (.not. (any(oscillating(:, c)) .or. any(oscillating(:, c + stride)))) cycle
-                  ! slopes (eq. 7) of the two cells, only for the faces that can carry a flux
-                  call cell_slope(box, exists, centre, q, c, k, d_min, slope_minus)
-                  call cell_slope(box, exists, centre, q, c + stride, k, d_min, slope_plus)
-                  associate (m_minus => mass(c), m_plus => mass(c + stride), &
+         do k = 1, box%dim
+            stride = box%stride(k)
+            ! oscillation flags (eq. 6) of every cell with both neighbours inside the padded box
+            do i3 = lo(3), hi(3)
+               do i2 = lo(2), hi(2)
+                  do i1 = lo(1), hi(1)
+                     c = 1 + (i1 - 1) + (i2 - 1) * box%stride(2) + (i3 - 1) * box%stride(3)
+                     if (.not. exists(c)) cycle
+                     position = [i1, i2, i3]
+                     along = position(k)
+                     if (along == 1 .or. along == box%n(k)) then
+                        oscillating(:, c) = .false.
+                     else if (exists(c - stride) .and. exists(c + stride)) then
+                        ! eq. 6 with the noise guard: both differences above round-off and of opposite sign
+                        noise = max(scale(c - stride), scale(c), scale(c + stride))
+                        do j = 1, nq
+                           left = q(j, c) - q(j, c - stride)
+                           right = q(j, c + stride) - q(j, c)
+                           oscillating(j, c) = abs(right) > noise .and. abs(left) > noise .and. right * left < 0.0_rp
+                        end do
+                     else
+                        oscillating(:, c) = .false.     ! a cell missing a neighbour cannot be tested [?]
+                     end if
+                  end do
+               end do
+            end do
+            ! faces (c, c + stride) with both cells present, at least one owned, and an oscillating cell
+            do i3 = lo(3), hi(3)
+               do i2 = lo(2), hi(2)
+                  do i1 = lo(1), hi(1)
+                     c = 1 + (i1 - 1) + (i2 - 1) * box%stride(2) + (i3 - 1) * box%stride(3)
+                     if (.not. exists(c)) cycle
+                     position = [i1, i2, i3]
+                     along = position(k)
+                     if (along < 2 .or. along > box%n(k) - 2) cycle
+                     if (.not. exists(c + stride)) cycle
+                     if (.not. (box%owned(c) .or. box%owned(c + stride))) cycle
+                     if (.not. (any(oscillating(:, c)) .or. any(oscillating(:, c + stride)))) cycle
+                     ! slopes (eq. 7) of the two cells, only for the faces that can carry a flux
+                     call cell_slope(box, exists, centre, q, c, k, d_min, slope_minus)
+                     call cell_slope(box, exists, centre, q, c + stride, k, d_min, slope_plus)
+                     associate (m_minus => mass(c), m_plus => mass(c + stride), &
                              x_minus => centre(k, c), x_plus => centre(k, c + stride))
-                     x_m = (m_minus * x_plus + m_plus * x_minus) / (m_minus + m_plus)         ! eq. 8
-                     do j = 1, nq
-                        ! oscillation limiter (eq. 6): gamma_o = gamma_max on an active face, else no flux
-                        if (options%both_cells_oscillate) then
-                           active = oscillating(j, c) .and. oscillating(j, c + stride)
-                        else
-                           active = oscillating(j, c) .or. oscillating(j, c + stride)
-                        end if
-                        if (.not. active) cycle
-                        jump = q(j, c) - q(j, c + stride)
-                        allowed = (x_m - x_minus) * slope_minus(j) - (x_m - x_plus) * slope_plus(j)   ! e_- - e_+
-                        limited_jump = sign0(jump) * min(max(sign0(jump) * (jump + allowed), 0.0_rp), abs(jump))  ! eq. 12
-                        flux = options%gamma_max * limited_jump / (n_faces * (m_minus + m_plus))   ! eqs. 5, 11, 1/n
-                        if (box%owned(c + stride)) dq(j, c + stride) = dq(j, c + stride) + m_minus * flux
-                        if (box%owned(c)) dq(j, c) = dq(j, c) - m_plus * flux
-                     end do
-                  end associate
+                        x_m = (m_minus * x_plus + m_plus * x_minus) / (m_minus + m_plus)         ! eq. 8
+                        do j = 1, nq
+                           ! oscillation limiter (eq. 6): gamma_o = gamma_max on an active face, else no flux
+                           if (options%both_cells_oscillate) then
+                              active = oscillating(j, c) .and. oscillating(j, c + stride)
+                           else
+                              active = oscillating(j, c) .or. oscillating(j, c + stride)
+                           end if
+                           if (.not. active) cycle
+                           jump = q(j, c) - q(j, c + stride)
+                           allowed = (x_m - x_minus) * slope_minus(j) - (x_m - x_plus) * slope_plus(j)   ! e_- - e_+
+                           limited_jump = sign0(jump) * min(max(sign0(jump) * (jump + allowed), 0.0_rp), abs(jump))  ! eq. 12
+                           flux = options%gamma_max * limited_jump / (n_faces * (m_minus + m_plus))   ! eqs. 5, 11, 1/n
+                           if (box%owned(c + stride)) dq(j, c + stride) = dq(j, c + stride) + m_minus * flux
+                           if (box%owned(c)) dq(j, c) = dq(j, c) - m_plus * flux
+                        end do
+                     end associate
+                  end do
                end do
             end do
          end do
-      end do
       end associate
    end subroutine limited_flux_increments
 
