@@ -4,10 +4,10 @@
 !> Saved: every particle's persistent state (position, velocity, mass, density, sbar, material, id) in
 !> each rank's order, the rank each slab came from, time, step, the next dt, the per-rank counters
 !> (lost particles, wall corrections), the empty-node mass tolerance, and the run's progress (next
-!> output time, the outputs written so far, the checkpoint number). Restarting on the same number of
-!> ranks restores every rank's particles in their order, so the continued run is bitwise identical to
-!> an uninterrupted one; on another number of ranks the particles are redistributed by position and
-!> re-sorted (equal to round-off).
+!> output time, the outputs written so far, the checkpoint number) and the decomposition (rank count
+!> and slab boundaries). Restarting on the same decomposition restores every rank's particles in their
+!> order, so the continued run is bitwise identical to an uninterrupted one; on another one the
+!> particles are redistributed by position and re-sorted (equal to round-off).
 !>
 !> A checkpoint is written as `<name>.tmp`, synced to disk, and renamed only when complete; it carries
 !> a format name and version, and an attribute `complete` written last. Reading checks all of these
@@ -58,6 +58,7 @@ contains
       call file%write_attribute('format_version', checkpoint_format_version, status)
       call file%write_attribute('sequence', sequence, status)
       call file%write_attribute('ranks', solver%domain%nranks, status)
+      call file%write_attribute('cuts', reshape(solver%domain%cuts, [size(solver%domain%cuts)]), status)
       call file%write_attribute('dim', solver%grid%dim, status)
       call file%write_attribute('cells', solver%grid%global_cells, status)
       call file%write_attribute('origin', solver%grid%origin, status)
@@ -223,6 +224,8 @@ contains
       integer :: version, complete, ranks_written, n, rank, n_ranks, p
       integer(i8) :: total, step
       integer(i8), allocatable :: rank_counts(:), lost(:), corrections(:)
+      integer, allocatable :: cuts(:)
+      logical :: same_decomposition
       real(rp) :: time, dt, mass_tolerance, next_output_time
       real(rp), allocatable :: x(:, :), v(:, :), mass(:), density(:), sbar(:, :)
       integer, allocatable :: material(:)
@@ -284,7 +287,14 @@ contains
          call file%close(status)
          return
       end if
-      if (ranks_written == n_ranks) then
+      ! the same decomposition: the same number of ranks and the same slab boundaries (cuts)
+      same_decomposition = ranks_written == n_ranks
+      if (same_decomposition) then
+         allocate (cuts(size(solver%domain%cuts)))
+         call file%read_attribute('cuts', cuts, status)
+         same_decomposition = all(cuts == reshape(solver%domain%cuts, [size(cuts)]))
+      end if
+      if (same_decomposition) then
          slab = slab_t(sum(rank_counts(1:rank)), rank_counts(rank + 1), total)
       else
          slab = even_slab(total, rank, n_ranks)
@@ -317,7 +327,7 @@ contains
       solver%step = step
       solver%dt = dt
       solver%mass_tolerance = mass_tolerance
-      if (ranks_written == n_ranks) then
+      if (same_decomposition) then
          solver%lost_particles = int(lost(rank + 1))
          solver%wall_corrections = int(corrections(rank + 1))
          ! keep each rank's order: the continued run is then bitwise identical to an uninterrupted one

@@ -5,15 +5,16 @@
 !>   /grid/node    nodal mass and velocity on the nodes of the active box of cells
 !>   /grid/cell    per material: cell averages of density and mean stress over the active box
 !>
-!> The active box is the smallest box of cells holding every particle. Nodal values are those of a
+!> The active box is the smallest box of cells holding every particle. A state with a particle outside
+!> the grid (a blow-up written for inspection) gets no grid fields. Nodal values are those of a
 !> particle-to-grid transfer of the current state (the solver's next step repeats it, so writing does
 !> not change the solution). A grid node belongs to the rank owning the cell of which it is the lower
 !> corner; the nodes on the upper faces of the box belong to the ranks owning the last cells.
 module field_output
-   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
    use kinds, only: rp, i8
    use error_status, only: status_t
-   use mpi_f08, only: MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER, MPI_MIN, MPI_MAX
+   use mpi_f08, only: MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER, MPI_LOGICAL, MPI_MIN, MPI_MAX, MPI_LAND
    use tensor_layout, only: mean_stress
    use background_grid, only: row_mass
    use world_frame, only: grid_to_world, grid_to_world_vectors, grid_to_world_tensors
@@ -53,7 +54,10 @@ contains
       call file%write_attribute('output_index', index, status)
       call file%write_attribute('dim', solver%grid%dim, status)
       if (solver%run%particle_output) call write_particle_fields(solver, file, entry, status)
-      if (solver%run%grid_output) call write_grid_fields(solver, file, entry, status)
+      ! the state of a blow-up written for inspection may have particles nowhere: then no grid
+      if (solver%run%grid_output) then
+         if (positions_in_grid(solver)) call write_grid_fields(solver, file, entry, status)
+      end if
       call file%close(status)
       call agree_on_status(status, solver%domain%comm)
       if (.not. status%ok) return
@@ -177,6 +181,27 @@ contains
          call file%write_block('grid/cell/mean_stress_'//name, cells, offset, local_cells, stress, status)
       end do
    end subroutine write_grid_fields
+
+   !> True if every particle of every rank has a finite position inside the grid. Collective.
+   logical function positions_in_grid(solver) result(inside)
+      type(solver_t), intent(in) :: solver
+      integer :: p, k
+      real(rp) :: s
+      inside = .true.
+      do p = 1, solver%particles%count
+         do k = 1, solver%grid%dim
+            if (.not. ieee_is_finite(solver%particles%x(k, p))) then
+               inside = .false.
+            else
+               s = (solver%particles%x(k, p) - solver%grid%origin(k)) * solver%grid%inv_h
+               inside = s >= 0.0_rp .and. s <= real(solver%grid%global_cells(k), rp) * (1.0_rp + epsilon(s))
+            end if
+            if (.not. inside) exit
+         end do
+         if (.not. inside) exit
+      end do
+      call MPI_Allreduce(MPI_IN_PLACE, inside, 1, MPI_LOGICAL, MPI_LAND, solver%domain%comm)
+   end function positions_in_grid
 
    !> Smallest box of global cells holding every particle (the whole grid when there are none). Collective.
    subroutine active_box(solver, box_lo, box_hi)

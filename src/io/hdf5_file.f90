@@ -10,7 +10,7 @@
 !> same order with the same names and global shapes. Failures are recorded in `status` with the file
 !> and object named; HDF5's own error stack printing is switched off.
 module hdf5_file
-   use, intrinsic :: iso_c_binding, only: c_loc, c_ptr
+   use, intrinsic :: iso_c_binding, only: c_loc, c_ptr, c_char
    use, intrinsic :: iso_fortran_env, only: int32, int64, real64
    use, intrinsic :: ieee_exceptions, only: ieee_flag_type, ieee_invalid, ieee_divide_by_zero, ieee_overflow, &
                                             ieee_get_halting_mode, ieee_set_halting_mode, ieee_set_flag
@@ -451,132 +451,100 @@ contains
 
    ! --- attributes of the root group ---------------------------------------------------------------
 
-   !> Create attribute `name` of the root group with `n` values (n = 0: a scalar) of type `type_id`.
-   subroutine create_attribute(self, name, type_id, n, attribute, status)
+   !> Create attribute `name` of the root group holding the `n` values of type `type_id` at `buffer`
+   !> (scalar: a scalar attribute of one value).
+   subroutine write_attribute_ptr(self, name, type_id, n, scalar, buffer, status)
       type(hdf5_file_t), intent(in) :: self
       character(len=*), intent(in) :: name
       integer(hid_t), intent(in) :: type_id
       integer, intent(in) :: n
-      integer(hid_t), intent(out) :: attribute
+      logical, intent(in) :: scalar
+      type(c_ptr), intent(in) :: buffer
       type(status_t), intent(inout) :: status
-      integer(hid_t) :: space
+      integer(hid_t) :: space, attribute
       integer :: error, e
-      if (n == 0) then
+      if (.not. status%ok) return
+      if (scalar) then
          call h5screate_f(H5S_SCALAR_F, space, error)
       else
          call h5screate_simple_f(1, [int(n, hsize_t)], space, error)
       end if
       call h5acreate_f(self%id, name, type_id, space, attribute, e)
       call h5sclose_f(space, error)
-      if (e < 0) call status%fail('cannot create attribute '//name//' in '//self%path)
-   end subroutine create_attribute
-
-   subroutine finish_attribute(self, name, attribute, error, status)
-      type(hdf5_file_t), intent(in) :: self
-      character(len=*), intent(in) :: name
-      integer(hid_t), intent(in) :: attribute
-      integer, intent(in) :: error
-      type(status_t), intent(inout) :: status
-      integer :: e
+      if (e < 0) then
+         call status%fail('cannot create attribute '//name//' in '//self%path)
+         return
+      end if
+      call h5awrite_f(attribute, type_id, buffer, error)
       call h5aclose_f(attribute, e)
       if (error < 0) call status%fail('cannot write attribute '//name//' of '//self%path)
-   end subroutine finish_attribute
+   end subroutine write_attribute_ptr
 
    subroutine attribute_write_real(self, name, value, status)
       class(hdf5_file_t), intent(in) :: self
       character(len=*), intent(in) :: name
-      real(rp), intent(in) :: value
+      real(rp), intent(in), target :: value
       type(status_t), intent(inout) :: status
-      call attribute_write_real_array(self, name, [value], status, scalar=.true.)
+      call write_attribute_ptr(self, name, real_type(), 1, .true., c_loc(value), status)
    end subroutine attribute_write_real
 
    subroutine attribute_write_int(self, name, value, status)
       class(hdf5_file_t), intent(in) :: self
       character(len=*), intent(in) :: name
-      integer, intent(in) :: value
+      integer, intent(in), target :: value
       type(status_t), intent(inout) :: status
-      call attribute_write_int_array(self, name, [value], status, scalar=.true.)
+      call write_attribute_ptr(self, name, int_type(), 1, .true., c_loc(value), status)
    end subroutine attribute_write_int
 
    subroutine attribute_write_i8(self, name, value, status)
       class(hdf5_file_t), intent(in) :: self
       character(len=*), intent(in) :: name
-      integer(i8), intent(in) :: value
+      integer(i8), intent(in), target :: value
       type(status_t), intent(inout) :: status
-      call attribute_write_i8_array(self, name, [value], status, scalar=.true.)
+      call write_attribute_ptr(self, name, i8_type(), 1, .true., c_loc(value), status)
    end subroutine attribute_write_i8
 
-   subroutine attribute_write_real_array(self, name, values, status, scalar)
+   subroutine attribute_write_real_array(self, name, values, status)
       class(hdf5_file_t), intent(in) :: self
       character(len=*), intent(in) :: name
-      real(rp), intent(in) :: values(:)
+      real(rp), intent(in), target, contiguous :: values(:)
       type(status_t), intent(inout) :: status
-      logical, intent(in), optional :: scalar
-      integer(hid_t) :: attribute
-      integer :: error
-      if (.not. status%ok) return
-      call create_attribute(self, name, real_type(), attribute_length(size(values), scalar), attribute, status)
-      if (.not. status%ok) return
-      call h5awrite_f(attribute, real_type(), values, [int(size(values), hsize_t)], error)
-      call finish_attribute(self, name, attribute, error, status)
+      call write_attribute_ptr(self, name, real_type(), size(values), .false., c_loc(values), status)
    end subroutine attribute_write_real_array
 
-   subroutine attribute_write_int_array(self, name, values, status, scalar)
+   subroutine attribute_write_int_array(self, name, values, status)
       class(hdf5_file_t), intent(in) :: self
       character(len=*), intent(in) :: name
-      integer, intent(in) :: values(:)
+      integer, intent(in), target, contiguous :: values(:)
       type(status_t), intent(inout) :: status
-      logical, intent(in), optional :: scalar
-      integer(hid_t) :: attribute
-      integer :: error
-      if (.not. status%ok) return
-      call create_attribute(self, name, int_type(), attribute_length(size(values), scalar), attribute, status)
-      if (.not. status%ok) return
-      call h5awrite_f(attribute, int_type(), values, [int(size(values), hsize_t)], error)
-      call finish_attribute(self, name, attribute, error, status)
+      call write_attribute_ptr(self, name, int_type(), size(values), .false., c_loc(values), status)
    end subroutine attribute_write_int_array
 
-   subroutine attribute_write_i8_array(self, name, values, status, scalar)
+   subroutine attribute_write_i8_array(self, name, values, status)
       class(hdf5_file_t), intent(in) :: self
       character(len=*), intent(in) :: name
-      integer(i8), intent(in) :: values(:)
+      integer(i8), intent(in), target, contiguous :: values(:)
       type(status_t), intent(inout) :: status
-      logical, intent(in), optional :: scalar
-      integer(hid_t) :: attribute
-      integer :: error
-      if (.not. status%ok) return
-      call create_attribute(self, name, i8_type(), attribute_length(size(values), scalar), attribute, status)
-      if (.not. status%ok) return
-      call h5awrite_f(attribute, i8_type(), values, [int(size(values), hsize_t)], error)
-      call finish_attribute(self, name, attribute, error, status)
+      call write_attribute_ptr(self, name, i8_type(), size(values), .false., c_loc(values), status)
    end subroutine attribute_write_i8_array
-
-   pure integer function attribute_length(n, scalar)
-      integer, intent(in) :: n
-      logical, intent(in), optional :: scalar
-      attribute_length = n
-      if (present(scalar)) then
-         if (scalar) attribute_length = 0
-      end if
-   end function attribute_length
 
    !> A fixed-length string attribute (trailing blanks removed; at least one character).
    subroutine attribute_write_string(self, name, value, status)
       class(hdf5_file_t), intent(in) :: self
       character(len=*), intent(in) :: name, value
       type(status_t), intent(inout) :: status
-      integer(hid_t) :: string_type, attribute
-      integer :: error, e, n
+      integer(hid_t) :: string_type
+      integer :: error, n
+      character(kind=c_char), allocatable, target :: text(:)
       if (.not. status%ok) return
       n = max(1, len_trim(value))
+      allocate (text(n))
+      text = ' '
+      text(1:len_trim(value)) = transfer(value(1:len_trim(value)), text, len_trim(value))
       call h5tcopy_f(H5T_FORTRAN_S1, string_type, error)
-      call h5tset_size_f(string_type, int(n, size_t), e)
-      call create_attribute(self, name, string_type, 0, attribute, status)
-      if (status%ok) then
-         call h5awrite_f(attribute, string_type, value(1:min(n, len(value))), [1_hsize_t], error)
-         call finish_attribute(self, name, attribute, min(error, e), status)
-      end if
-      call h5tclose_f(string_type, e)
+      call h5tset_size_f(string_type, int(n, size_t), error)
+      call write_attribute_ptr(self, name, string_type, 1, .true., c_loc(text), status)
+      call h5tclose_f(string_type, error)
    end subroutine attribute_write_string
 
    !> Open root attribute `name`; fails with a message naming it if it is missing or, when `n` is
@@ -614,76 +582,65 @@ contains
       end if
    end subroutine open_attribute
 
+   !> Read the n values of attribute `name` (n = 1: also a scalar) as type `type_id` into `buffer`.
+   subroutine read_attribute_ptr(self, name, type_id, n, buffer, status)
+      type(hdf5_file_t), intent(in) :: self
+      character(len=*), intent(in) :: name
+      integer(hid_t), intent(in) :: type_id
+      integer, intent(in) :: n
+      type(c_ptr), intent(in) :: buffer
+      type(status_t), intent(inout) :: status
+      integer(hid_t) :: attribute
+      type(c_ptr) :: destination
+      integer :: error, e
+      call open_attribute(self, name, attribute, status, n)
+      if (.not. status%ok) return
+      destination = buffer                ! h5aread_f takes the address intent(inout)
+      call h5aread_f(attribute, type_id, destination, error)
+      call h5aclose_f(attribute, e)
+      if (error < 0) call status%fail('cannot read attribute '//name//' of '//self%path)
+   end subroutine read_attribute_ptr
+
    subroutine attribute_read_real(self, name, value, status)
       class(hdf5_file_t), intent(in) :: self
       character(len=*), intent(in) :: name
-      real(rp), intent(inout) :: value
+      real(rp), intent(inout), target :: value
       type(status_t), intent(inout) :: status
-      integer(hid_t) :: attribute
-      integer :: error, e
-      call open_attribute(self, name, attribute, status, 1)
-      if (.not. status%ok) return
-      call h5aread_f(attribute, real_type(), value, [1_hsize_t], error)
-      call h5aclose_f(attribute, e)
-      if (error < 0) call status%fail('cannot read attribute '//name//' of '//self%path)
+      call read_attribute_ptr(self, name, real_type(), 1, c_loc(value), status)
    end subroutine attribute_read_real
 
    subroutine attribute_read_int(self, name, value, status)
       class(hdf5_file_t), intent(in) :: self
       character(len=*), intent(in) :: name
-      integer, intent(inout) :: value
+      integer, intent(inout), target :: value
       type(status_t), intent(inout) :: status
-      integer(hid_t) :: attribute
-      integer :: error, e
-      call open_attribute(self, name, attribute, status, 1)
-      if (.not. status%ok) return
-      call h5aread_f(attribute, int_type(), value, [1_hsize_t], error)
-      call h5aclose_f(attribute, e)
-      if (error < 0) call status%fail('cannot read attribute '//name//' of '//self%path)
+      call read_attribute_ptr(self, name, int_type(), 1, c_loc(value), status)
    end subroutine attribute_read_int
 
    subroutine attribute_read_i8(self, name, value, status)
       class(hdf5_file_t), intent(in) :: self
       character(len=*), intent(in) :: name
-      integer(i8), intent(inout) :: value
+      integer(i8), intent(inout), target :: value
       type(status_t), intent(inout) :: status
-      integer(hid_t) :: attribute
-      integer :: error, e
-      call open_attribute(self, name, attribute, status, 1)
-      if (.not. status%ok) return
-      call h5aread_f(attribute, i8_type(), value, [1_hsize_t], error)
-      call h5aclose_f(attribute, e)
-      if (error < 0) call status%fail('cannot read attribute '//name//' of '//self%path)
+      call read_attribute_ptr(self, name, i8_type(), 1, c_loc(value), status)
    end subroutine attribute_read_i8
 
    !> Read an array attribute of exactly size(values) reals.
    subroutine attribute_read_real_array(self, name, values, status)
       class(hdf5_file_t), intent(in) :: self
       character(len=*), intent(in) :: name
-      real(rp), intent(inout) :: values(:)
+      real(rp), intent(inout), target, contiguous :: values(:)
       type(status_t), intent(inout) :: status
-      integer(hid_t) :: attribute
-      integer :: error, e
-      call open_attribute(self, name, attribute, status, size(values))
-      if (.not. status%ok) return
-      call h5aread_f(attribute, real_type(), values, [int(size(values), hsize_t)], error)
-      call h5aclose_f(attribute, e)
-      if (error < 0) call status%fail('cannot read attribute '//name//' of '//self%path)
+      call read_attribute_ptr(self, name, real_type(), size(values), c_loc(values), status)
    end subroutine attribute_read_real_array
 
    !> Read an array attribute of exactly size(values) default integers.
    subroutine attribute_read_int_array(self, name, values, status)
       class(hdf5_file_t), intent(in) :: self
       character(len=*), intent(in) :: name
-      integer, intent(inout) :: values(:)
+      integer, intent(inout), target, contiguous :: values(:)
       type(status_t), intent(inout) :: status
-      integer(hid_t) :: attribute
-      integer :: error, e
-      call open_attribute(self, name, attribute, status, size(values))
-      if (.not. status%ok) return
-      call h5aread_f(attribute, int_type(), values, [int(size(values), hsize_t)], error)
-      call h5aclose_f(attribute, e)
-      if (error < 0) call status%fail('cannot read attribute '//name//' of '//self%path)
+      call read_attribute_ptr(self, name, int_type(), size(values), c_loc(values), status)
    end subroutine attribute_read_int_array
 
    !> Read a string attribute into `value` (blank-padded; cut if longer than len(value)).

@@ -26,17 +26,22 @@ contains
    pure function fields_file(index) result(path)
       integer, intent(in) :: index
       character(len=:), allocatable :: path
-      character(len=16) :: number
-      write (number, '(i6.6)') index
-      path = fields_folder//'/fields_'//trim(number)//'.h5'
+      path = fields_folder//'/fields_'//six_digits(index)//'.h5'
    end function fields_file
 
    !> Path of checkpoint number `sequence`, relative to the output folder.
    pure function checkpoint_file(sequence) result(path)
       integer, intent(in) :: sequence
       character(len=:), allocatable :: path
-      character(len=16) :: number
-      write (number, '(i6.6)') sequence
-      path = checkpoint_folder//'/checkpoint_'//trim(number)//'.h5'
+      path = checkpoint_folder//'/checkpoint_'//six_digits(sequence)//'.h5'
    end function checkpoint_file
+
+   !> 42 -> '000042' (more digits when needed).
+   pure function six_digits(number) result(text)
+      integer, intent(in) :: number
+      character(len=:), allocatable :: text
+      character(len=16) :: buffer
+      write (buffer, '(i6.6)') number
+      text = trim(adjustl(buffer))
+   end function six_digits
 end module output_layout

@@ -146,13 +146,17 @@ def main():
     checks.check(result.returncode == 3 and len(errors) == 1 and "cannot create or write to output folder" in errors[0],
                  "unwritable folder refused with status 3", f"{result.returncode}: {errors}")
 
-    # --overwrite: a shorter run replaces the previous one entirely
-    scene = flotsam.scene(template, "short.nml", "killed", end_time="0.02")
+    # --overwrite: a shorter run replaces the previous one entirely; it checkpoints by wall-clock time
+    scene = flotsam.scene(template, "short.nml", "killed", end_time="0.02", checkpoint_interval_steps="0",
+                          checkpoint_interval_wall="0.02")
     result = flotsam.run(scene, RANKS, "--overwrite")
     checks.check(result.returncode == 0, "--overwrite replaces a previous run", result.stderr[-2000:])
     left = sorted(os.listdir(flotsam.path("killed", "checkpoints")))
-    checks.check("checkpoint_000020.h5" not in left and len(read_diagnostics(flotsam.path("killed"))) == 3,
-                 "--overwrite leaves no file of the previous run", f"{left}")
+    with open(flotsam.path("killed", "checkpoints", "latest")) as f:
+        latest = f.read().strip()
+    checks.check(left[-2] == latest and len(read_diagnostics(flotsam.path("killed"))) == 3,
+                 "--overwrite leaves no file of the previous run", f"latest {latest}, files {left}")
+    checks.check(len(left) >= 3, "checkpoints every checkpoint_interval_wall seconds", f"{left}")
 
     # --- blow-up -------------------------------------------------------------------------------------
     flotsam.remove("blow_up")
