@@ -7,8 +7,8 @@
 !> within the owned extent of the other axes; the rest of the padding is never read.
 module cell_halo
    use kinds, only: rp
-   use mpi_f08, only: MPI_Request, MPI_Isend, MPI_Irecv, MPI_Waitall, MPI_DOUBLE_PRECISION, &
-                      MPI_STATUSES_IGNORE, MPI_PROC_NULL
+   use mpi_f08, only: MPI_PROC_NULL
+   use face_exchange, only: exchange_with_face_neighbours
    use domain_decomposition, only: domain_t
    use background_grid, only: grid_t
    implicit none
@@ -76,7 +76,6 @@ contains
       type(padded_cells_t), intent(in) :: box
       real(rp), intent(inout) :: field(:, :)
       real(rp), allocatable :: send_buf(:, :), recv_buf(:, :)
-      type(MPI_Request) :: requests(4)
       integer :: k, side, count, nv, first_owned(2), first_ghost(2)
       integer, parameter :: tag = 301
 
@@ -91,15 +90,7 @@ contains
          do side = 1, 2
             call copy_layers(grid, box, k, first_owned(side), field, send_buf(:, side), to_buffer=.true.)
          end do
-         do side = 1, 2
-            call MPI_Irecv(recv_buf(:, side), count, MPI_DOUBLE_PRECISION, domain%neighbour(side, k), tag, &
-                           domain%comm, requests(side))
-         end do
-         do side = 1, 2
-            call MPI_Isend(send_buf(:, side), count, MPI_DOUBLE_PRECISION, domain%neighbour(side, k), tag, &
-                           domain%comm, requests(2 + side))
-         end do
-         call MPI_Waitall(4, requests, MPI_STATUSES_IGNORE)
+         call exchange_with_face_neighbours(domain, k, send_buf, recv_buf, tag)
          do side = 1, 2
             if (domain%neighbour(side, k) /= MPI_PROC_NULL) &
                call copy_layers(grid, box, k, first_ghost(side), field, recv_buf(:, side), to_buffer=.false.)

@@ -6,8 +6,8 @@
 !> Axis by axis, edge and corner nodes pick up the sums of all 2**dim ranks that share them.
 module node_halo
    use kinds, only: rp
-   use mpi_f08, only: MPI_Request, MPI_Isend, MPI_Irecv, MPI_Waitall, MPI_DOUBLE_PRECISION, &
-                      MPI_STATUSES_IGNORE, MPI_PROC_NULL
+   use mpi_f08, only: MPI_PROC_NULL
+   use face_exchange, only: exchange_with_face_neighbours
    use domain_decomposition, only: domain_t
    use background_grid, only: grid_t
    implicit none
@@ -23,7 +23,6 @@ contains
       type(grid_t), intent(in) :: grid
       real(rp), intent(inout) :: field(:, :)
       real(rp), allocatable :: send_buf(:, :), recv_buf(:, :)
-      type(MPI_Request) :: requests(4)
       integer :: k, side, nv, plane_size, count, plane_index(2)
       integer, parameter :: tag = 101
 
@@ -37,16 +36,7 @@ contains
          do side = 1, 2
             call pack_plane(grid, k, plane_index(side), field, send_buf(:, side))
          end do
-         ! side 1 = lower neighbour, side 2 = upper neighbour
-         do side = 1, 2
-            call MPI_Irecv(recv_buf(:, side), count, MPI_DOUBLE_PRECISION, domain%neighbour(side, k), tag, &
-                           domain%comm, requests(side))
-         end do
-         do side = 1, 2
-            call MPI_Isend(send_buf(:, side), count, MPI_DOUBLE_PRECISION, domain%neighbour(side, k), tag, &
-                           domain%comm, requests(2 + side))
-         end do
-         call MPI_Waitall(4, requests, MPI_STATUSES_IGNORE)
+         call exchange_with_face_neighbours(domain, k, send_buf, recv_buf, tag)
          do side = 1, 2
             if (domain%neighbour(side, k) /= MPI_PROC_NULL) &
                call add_plane(grid, k, plane_index(side), recv_buf(:, side), field)
