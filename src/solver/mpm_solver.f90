@@ -90,6 +90,7 @@ contains
       if (seed) call seed_bodies(scene, self%grid, self%domain, self%particles)
       call update_cells(self%grid, self%particles)
       call sort_by_material_and_cell(self%grid, self%particles)
+      if (allocated(self%remapped_momentum)) deallocate (self%remapped_momentum)
       if (self%musl) allocate (self%remapped_momentum(self%grid%dim, self%grid%node_count))
 
       ! a node is "empty" below a millionth of a millionth of the lightest particle
