@@ -49,39 +49,40 @@ contains
       allocate (self%cell_mass(cell_count), self%average(n_sigma, cell_count))
    end subroutine c0_size_cell_arrays
 
-   !> Filter part A: d_p := d~_c ([Y17] eq. 4, left).
+   !> Filter part A: d_p := d~_c ([Y17] eq. 4, left). Volumetric part: the dim in-plane normal components.
    subroutine c0_filter_strain_rate(self, context, particles)
       class(c0_anti_locking_t), intent(inout) :: self
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
-      integer :: first, last
-      first = context%first
-      last = context%last
-      if (last < first) return
-      if (self%volumetric_only) then
-         call replace_volumetric_part(self, particles, first, last, particles%strain_rate(:, first:last), &
-                                      context%grid%dim)
-      else
-         call replace_by_cell_average(particles, first, last, self%cell_mass, particles%strain_rate(:, first:last), &
-                                      self%average)
-      end if
+      call filter_slice(self, context, particles, particles%strain_rate, context%grid%dim)
    end subroutine c0_filter_strain_rate
 
-   !> Filter part B: s_p := s~_c ([Y17] eq. 4, right).
+   !> Filter part B: s_p := s~_c ([Y17] eq. 4, right). Volumetric part: the mean of the 3 normal components.
    subroutine c0_filter_stress(self, context, particles)
       class(c0_anti_locking_t), intent(inout) :: self
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
+      call filter_slice(self, context, particles, particles%sbar, 3)
+   end subroutine c0_filter_stress
+
+   !> Replace the tensors of the material's slice by their cell average (or only their volumetric part,
+   !> the mean of the first n_normal components, with volumetric_only).
+   subroutine filter_slice(self, context, particles, tensors, n_normal)
+      type(c0_anti_locking_t), intent(inout) :: self
+      type(stage_context_t), intent(in) :: context
+      type(particle_set_t), intent(in) :: particles
+      real(rp), intent(inout) :: tensors(:, :)
+      integer, intent(in) :: n_normal
       integer :: first, last
       first = context%first
       last = context%last
       if (last < first) return
       if (self%volumetric_only) then
-         call replace_volumetric_part(self, particles, first, last, particles%sbar(:, first:last), 3)
+         call replace_volumetric_part(self, particles, first, last, tensors(:, first:last), n_normal)
       else
-         call replace_by_cell_average(particles, first, last, self%cell_mass, particles%sbar(:, first:last), self%average)
+         call replace_by_cell_average(particles, first, last, self%cell_mass, tensors(:, first:last), self%average)
       end if
-   end subroutine c0_filter_stress
+   end subroutine filter_slice
 
    !> Replace the mean of the first n_normal normal components by its cell average:
    !> t_p(k) += (mean_c - mean_p) for k = 1..n_normal.

@@ -64,28 +64,22 @@ contains
       class(node_based_anti_locking_t), intent(inout) :: self
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
-      integer :: first, last
-      first = context%first
-      last = context%last
-      call project_and_interpolate(self, context, particles, first, last, particles%strain_rate(:, first:last))
+      call project_and_interpolate(self, context, particles, particles%strain_rate(:, context%first:context%last))
    end subroutine nb_filter_strain_rate
 
    subroutine nb_filter_stress(self, context, particles)
       class(node_based_anti_locking_t), intent(inout) :: self
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
-      integer :: first, last
-      first = context%first
-      last = context%last
-      call project_and_interpolate(self, context, particles, first, last, particles%sbar(:, first:last))
+      call project_and_interpolate(self, context, particles, particles%sbar(:, context%first:context%last))
    end subroutine nb_filter_stress
 
-   !> values(:, p) := sum_i N_ip (sum_q N_iq m_q values_q / m_i) for the slice first..last. Collective.
-   subroutine project_and_interpolate(self, context, particles, first, last, values)
+   !> values(:, q) := sum_i N_iq (sum_r N_ir m_r values_r / m_i) for the material's slice (values(:, q)
+   !> belongs to particle context%first + q - 1). Collective.
+   subroutine project_and_interpolate(self, context, particles, values)
       type(node_based_anti_locking_t), intent(in) :: self
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(in) :: particles
-      integer, intent(in) :: first, last
       real(rp), intent(inout) :: values(:, :)
       real(rp), allocatable :: nodal(:, :)
       integer :: q, a, node, i
@@ -94,17 +88,17 @@ contains
       grid => context%grid
       allocate (nodal(size(values, 1), grid%node_count))
       nodal = 0.0_rp
-      do q = 1, last - first + 1
+      do q = 1, size(values, 2)
          do a = 1, n_corners(grid%dim)
             node = self%base(q) + grid%corner_stride(a)
-            nodal(:, node) = nodal(:, node) + self%weight(a, q) * particles%mass(first + q - 1) * values(:, q)
+            nodal(:, node) = nodal(:, node) + self%weight(a, q) * particles%mass(context%first + q - 1) * values(:, q)
          end do
       end do
       call sum_shared_nodes(context%domain, grid, nodal)
       do i = 1, grid%node_count
          if (self%nodal_mass(i) > 0.0_rp) nodal(:, i) = nodal(:, i) / self%nodal_mass(i)
       end do
-      do q = 1, last - first + 1
+      do q = 1, size(values, 2)
          values(:, q) = 0.0_rp
          do a = 1, n_corners(grid%dim)
             node = self%base(q) + grid%corner_stride(a)
