@@ -9,6 +9,7 @@ module background_grid
    use kinds, only: rp
    use shape_functions, only: n_corners, corner_offset
    use domain_decomposition, only: domain_t
+   use world_frame, only: frame_t
    implicit none
    private
 
@@ -19,6 +20,7 @@ module background_grid
       integer :: dim = 2
       real(rp) :: h = 1.0_rp, inv_h = 1.0_rp       !< cell edge and its inverse
       real(rp) :: origin(3) = 0.0_rp               !< lower corner of the whole grid (grid frame)
+      type(frame_t) :: frame                       !< the grid frame's placement in the world
       integer :: global_cells(3) = 1
       integer :: node_lo(3) = 0, node_hi(3) = 0    !< global index range of the local nodes
       integer :: n_nodes(3) = 1, node_count = 0
@@ -42,16 +44,18 @@ module background_grid
 contains
 
    !> Size the local node box from the owned cells of `domain`.
-   subroutine grid_init(self, domain, origin, h)
+   subroutine grid_init(self, domain, origin, h, frame)
       class(grid_t), intent(inout) :: self
       type(domain_t), intent(in) :: domain
       real(rp), intent(in) :: origin(3), h
+      type(frame_t), intent(in), optional :: frame
       integer :: a, k, stride(3)
 
       self%dim = domain%dim
       self%h = h
       self%inv_h = 1.0_rp / h
       self%origin = origin
+      if (present(frame)) self%frame = frame
       self%global_cells = domain%global_cells
       self%cell_lo = domain%cell_lo
       self%cell_hi = domain%cell_hi

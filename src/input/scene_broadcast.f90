@@ -21,7 +21,7 @@ contains
       type(MPI_Comm), intent(in) :: comm
       integer, intent(in) :: root
       character(len=1), allocatable :: bytes(:)
-      integer :: counts(2), rank_count(2)
+      integer :: counts(4), rank_count(4)
 
       call resize(bytes, size(transfer(scene%source_file, byte_mold)))
       bytes(:) = transfer(scene%source_file, byte_mold)
@@ -47,13 +47,19 @@ contains
       counts = -1
       if (allocated(scene%materials)) counts(1) = size(scene%materials)
       if (allocated(scene%bodies)) counts(2) = size(scene%bodies)
+      if (allocated(scene%walls)) counts(3) = size(scene%walls)
+      if (allocated(scene%inlets)) counts(4) = size(scene%inlets)
       rank_count = counts
       call MPI_Bcast(counts, size(counts), MPI_INTEGER, root, comm)
       if (any(counts /= rank_count)) then
          if (allocated(scene%materials)) deallocate (scene%materials)
          if (allocated(scene%bodies)) deallocate (scene%bodies)
+         if (allocated(scene%walls)) deallocate (scene%walls)
+         if (allocated(scene%inlets)) deallocate (scene%inlets)
          if (counts(1) >= 0) allocate (scene%materials(counts(1)))
          if (counts(2) >= 0) allocate (scene%bodies(counts(2)))
+         if (counts(3) >= 0) allocate (scene%walls(counts(3)))
+         if (counts(4) >= 0) allocate (scene%inlets(counts(4)))
       end if
 
       if (counts(1) > 0) then
@@ -67,6 +73,18 @@ contains
          bytes(:) = transfer(scene%bodies, byte_mold)
          call broadcast_bytes(bytes, comm, root)
          scene%bodies(:) = transfer(bytes, scene%bodies, counts(2))
+      end if
+      if (counts(3) > 0) then
+         call resize(bytes, size(transfer(scene%walls, byte_mold)))
+         bytes(:) = transfer(scene%walls, byte_mold)
+         call broadcast_bytes(bytes, comm, root)
+         scene%walls(:) = transfer(bytes, scene%walls, counts(3))
+      end if
+      if (counts(4) > 0) then
+         call resize(bytes, size(transfer(scene%inlets, byte_mold)))
+         bytes(:) = transfer(scene%inlets, byte_mold)
+         call broadcast_bytes(bytes, comm, root)
+         scene%inlets(:) = transfer(bytes, scene%inlets, counts(4))
       end if
    end subroutine broadcast_scene
 

@@ -36,16 +36,47 @@ module scene_description
       real(rp) :: speed_limit = 0.0_rp        !< particle speed taken as a blow-up [m/s]; 0: 10 x fastest wave
    end type run_control_t
 
-   !> `&grid` and `&box_walls`: the background grid in its own frame, and its walls.
+   !> `&grid` and `&box_walls`: the scene box (world frame), the grid that covers it, and the box's walls.
+   !> The grid may be rotated against the world by `rotation` about z, pivoting on `origin` (the paper's
+   !> theta_g); it is axis-aligned in its own frame and covers the rotated box with whole cells.
    type, public :: grid_spec_t
       integer :: dim = 2                      !< 2 (plane strain) or 3
       real(rp) :: cell_size = 0.0_rp          !< cell edge h [m]
-      real(rp) :: origin(3) = 0.0_rp          !< lower corner [m]
-      real(rp) :: extent(3) = 0.0_rp          !< edge lengths [m], whole multiples of cell_size
+      real(rp) :: origin(3) = 0.0_rp          !< lower corner of the scene box (world frame) [m]
+      real(rp) :: extent(3) = 0.0_rp          !< edge lengths of the scene box [m], whole multiples of cell_size
+      real(rp) :: rotation = 0.0_rp           !< grid rotation theta_g, counter-clockwise about z [degrees]
       integer :: ncells(3) = 1                !< derived: extent / cell_size (1 on unused axes)
       !> wall condition per side: (1, k) lower side, (2, k) upper side of axis k
       character(len=name_len) :: wall(2, 3) = wall_none
    end type grid_spec_t
+
+   !> `&wall`: a plane wall (a segment in 2-D, a planar patch in 3-D), world frame. The wall is the part
+   !> of the plane through `point` with inward unit normal `normal` that lies inside the box lower..upper
+   !> (unbounded by default). The solver turns the `&box_walls` sides into walls of this kind.
+   type, public :: wall_spec_t
+      real(rp) :: point(3) = 0.0_rp           !< a point of the wall [m]
+      real(rp) :: normal(3) = 0.0_rp          !< normal pointing into the fluid (made unit when resolved)
+      real(rp) :: lower(3) = -huge(1.0_rp)    !< extent of the wall: lower corner of its bounding box [m]
+      real(rp) :: upper(3) = huge(1.0_rp)     !< upper corner [m]
+      character(len=name_len) :: condition = wall_slip
+   end type wall_spec_t
+
+   !> `&inlet`: an opening through which fluid enters at a constant speed (algorithms.md section 4.3).
+   !> The opening lies in the plane through `point` normal to `direction` (the flow direction, world
+   !> frame); it spans `height` along t = (-d_y, d_x, 0) from `point` and, in 3-D, `width` along z.
+   type, public :: inlet_spec_t
+      character(len=name_len) :: material = ''
+      integer :: material_index = 0           !< derived: position in scene%materials
+      real(rp) :: point(3) = 0.0_rp           !< lower end of the opening [m]
+      real(rp) :: direction(3) = 0.0_rp       !< flow direction (made unit when resolved)
+      real(rp) :: height = 0.0_rp             !< size of the opening along t [m] (H of rho v H)
+      real(rp) :: width = 0.0_rp              !< 3-D: size of the opening along z [m]
+      real(rp) :: velocity = 0.0_rp           !< inflow speed v0 [m/s]
+      real(rp) :: start_time = 0.0_rp         !< the inlet opens [s]
+      real(rp) :: end_time = huge(1.0_rp)     !< the inlet closes and acts as a wall [s]
+      integer :: particles_per_cell = 2       !< particles per cell per direction
+      logical :: hydrostatic = .false.        !< new particles carry the hydrostatic pressure below the stream top
+   end type inlet_spec_t
 
    !> `&material`: one constitutive model and its parameters.
    type, public :: material_spec_t
@@ -84,5 +115,7 @@ module scene_description
       real(rp) :: gravity(3) = 0.0_rp         !< `&gravity acceleration=` [m/s^2]
       type(material_spec_t), allocatable :: materials(:)
       type(body_spec_t), allocatable :: bodies(:)
+      type(wall_spec_t), allocatable :: walls(:)      !< `&wall` groups (the `&box_walls` sides are in grid)
+      type(inlet_spec_t), allocatable :: inlets(:)
    end type scene_t
 end module scene_description

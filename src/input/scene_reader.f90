@@ -10,8 +10,8 @@ module scene_reader
    use mpi_f08, only: MPI_Comm, MPI_Comm_rank
    use kinds, only: rp, i8, path_len
    use error_status, only: status_t
-   use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, &
-                                model_newtonian_fluid, model_linear_elastic
+   use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
+                                inlet_spec_t, model_newtonian_fluid, model_linear_elastic
    use namelist_scan, only: namelist_file_t, namelist_group_t, scan_namelist_file
    use scene_validation, only: validate_scene, resolve_scene, stabilization_keywords, oscillation_rule_keywords
    use scene_broadcast, only: broadcast_scene
@@ -26,13 +26,13 @@ module scene_reader
    integer, parameter :: root = 0
 
    character(len=*), parameter :: known_groups(*) = &
-      [character(len=9) :: 'run', 'grid', 'box_walls', 'gravity', 'material', 'body']
+      [character(len=9) :: 'run', 'grid', 'box_walls', 'gravity', 'material', 'body', 'wall', 'inlet']
    !> Groups that may appear at most once.
    character(len=*), parameter :: singleton_groups(*) = [character(len=9) :: 'run', 'grid', 'box_walls', 'gravity']
    !> Groups that may appear any number of times, one scene entry each.
-   character(len=*), parameter :: repeated_groups(*) = [character(len=8) :: 'material', 'body']
+   character(len=*), parameter :: repeated_groups(*) = [character(len=8) :: 'material', 'body', 'wall', 'inlet']
    !> Groups a scene file must contain.
-   character(len=*), parameter :: required_groups(*) = [character(len=8) :: 'run', 'grid', 'material', 'body']
+   character(len=*), parameter :: required_groups(*) = [character(len=8) :: 'run', 'grid', 'material']
 
    !> The variables of every group: their kind names the expected value in messages.
    type :: variable_info_t
@@ -65,6 +65,7 @@ module scene_reader
       variable_info_t('grid', 'cell_size', 'real', .true.), &
       variable_info_t('grid', 'origin', 'real3', .false.), &
       variable_info_t('grid', 'extent', 'real3', .true.), &
+      variable_info_t('grid', 'rotation', 'real', .false.), &
       variable_info_t('box_walls', 'x_min', 'string', .false.), &
       variable_info_t('box_walls', 'x_max', 'string', .false.), &
       variable_info_t('box_walls', 'y_min', 'string', .false.), &
@@ -91,7 +92,22 @@ module scene_reader
       variable_info_t('body', 'particles_per_cell', 'integer', .false.), &
       variable_info_t('body', 'velocity', 'real3', .false.), &
       variable_info_t('body', 'hydrostatic', 'logical', .false.), &
-      variable_info_t('body', 'free_surface_level', 'real', .false.)]
+      variable_info_t('body', 'free_surface_level', 'real', .false.), &
+      variable_info_t('wall', 'point', 'real3', .true.), &
+      variable_info_t('wall', 'normal', 'real3', .true.), &
+      variable_info_t('wall', 'lower', 'real3', .false.), &
+      variable_info_t('wall', 'upper', 'real3', .false.), &
+      variable_info_t('wall', 'condition', 'string', .false.), &
+      variable_info_t('inlet', 'material', 'string', .true.), &
+      variable_info_t('inlet', 'point', 'real3', .true.), &
+      variable_info_t('inlet', 'direction', 'real3', .true.), &
+      variable_info_t('inlet', 'height', 'real', .true.), &
+      variable_info_t('inlet', 'width', 'real', .false.), &
+      variable_info_t('inlet', 'velocity', 'real', .true.), &
+      variable_info_t('inlet', 'start_time', 'real', .false.), &
+      variable_info_t('inlet', 'end_time', 'real', .false.), &
+      variable_info_t('inlet', 'particles_per_cell', 'integer', .false.), &
+      variable_info_t('inlet', 'hydrostatic', 'logical', .false.)]
 
    !> Namelist buffers of string values are longer than the scene's fields, so that a value too long
    !> for its field is reported instead of cut.
@@ -237,12 +253,15 @@ contains
       type(scene_t) :: one
       type(material_spec_t) :: default_material
       type(body_spec_t) :: default_body
+      type(wall_spec_t) :: default_wall
+      type(inlet_spec_t) :: default_inlet
       character(len=512) :: message
       character(len=:), allocatable :: group
       integer :: g, k, n, ios
 
-      allocate (scene%materials(file%count('material')), scene%bodies(file%count('body')))
-      allocate (one%materials(1), one%bodies(1))
+      allocate (scene%materials(file%count('material')), scene%bodies(file%count('body')), &
+                scene%walls(file%count('wall')), scene%inlets(file%count('inlet')))
+      allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1))
       do g = 1, size(repeated_groups)
          group = trim(repeated_groups(g))
          n = file%count(group)
@@ -251,6 +270,8 @@ contains
          do
             one%materials(1) = default_material
             one%bodies(1) = default_body
+            one%walls(1) = default_wall
+            one%inlets(1) = default_inlet
             message = ''
             call read_group(group, one, 1, ios, message, unit=unit)
             ! gfortran can also end a read that failed inside a group with iostat_end (`hydrostatic = 'yes'`).
@@ -267,6 +288,10 @@ contains
                scene%materials(k) = one%materials(1)
             case ('body')
                scene%bodies(k) = one%bodies(1)
+            case ('wall')
+               scene%walls(k) = one%walls(1)
+            case ('inlet')
+               scene%inlets(k) = one%inlets(1)
             end select
          end do
          if (k /= n) then
@@ -294,6 +319,10 @@ contains
             where = group_context(file%path, group, k, name_detail(scene%materials(k)%name))
          case ('body')
             where = group_context(file%path, group, k, material_detail(scene%bodies(k)%material))
+         case ('wall')
+            where = group_context(file%path, group, k)
+         case ('inlet')
+            where = group_context(file%path, group, k, material_detail(scene%inlets(k)%material))
          case default
             where = group_context(file%path, group, 0)
          end select
@@ -364,7 +393,7 @@ contains
          call status%fail(file%path//': group &'//group//label//': '//trim(message))
          return
       end if
-      allocate (one%materials(1), one%bodies(1))
+      allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1))
       associate (items => file%groups(g)%items)
          do i = 1, size(items)
             prefix = file%path//': line '//int_text(items(i)%line)//': group &'//group//label
@@ -468,6 +497,10 @@ contains
          call read_material_group(scene%materials(k), ios, message, unit, text)
       case ('body')
          call read_body_group(scene%bodies(k), ios, message, unit, text)
+      case ('wall')
+         call read_wall_group(scene%walls(k), ios, message, unit, text)
+      case ('inlet')
+         call read_inlet_group(scene%inlets(k), ios, message, unit, text)
       case default
          ios = value_too_long
          message = 'no namelist group &'//group
@@ -555,13 +588,14 @@ contains
       integer, intent(in), optional :: unit
       character(len=*), intent(in), optional :: text
       integer :: dim
-      real(rp) :: cell_size, origin(3), extent(3)
-      namelist /grid/ dim, cell_size, origin, extent
+      real(rp) :: cell_size, origin(3), extent(3), rotation
+      namelist /grid/ dim, cell_size, origin, extent, rotation
 
       dim = spec%dim
       cell_size = spec%cell_size
       origin = spec%origin
       extent = spec%extent
+      rotation = spec%rotation
       if (present(text)) then
          read (text, nml=grid, iostat=ios, iomsg=message)
       else
@@ -572,6 +606,7 @@ contains
       spec%cell_size = cell_size
       spec%origin = origin
       spec%extent = extent
+      spec%rotation = rotation
    end subroutine read_grid_group
 
    subroutine read_box_walls_group(spec, ios, message, unit, text)
@@ -713,4 +748,75 @@ contains
       spec%hydrostatic = hydrostatic
       spec%free_surface_level = free_surface_level
    end subroutine read_body_group
+
+   subroutine read_wall_group(spec, ios, message, unit, text)
+      type(wall_spec_t), intent(inout) :: spec
+      integer, intent(out) :: ios
+      character(len=*), intent(inout) :: message
+      integer, intent(in), optional :: unit
+      character(len=*), intent(in), optional :: text
+      character(len=text_len) :: condition
+      real(rp) :: point(3), normal(3), lower(3), upper(3)
+      namelist /wall/ point, normal, lower, upper, condition
+
+      point = spec%point
+      normal = spec%normal
+      lower = spec%lower
+      upper = spec%upper
+      condition = spec%condition
+      if (present(text)) then
+         read (text, nml=wall, iostat=ios, iomsg=message)
+      else
+         read (unit, nml=wall, iostat=ios, iomsg=message)
+      end if
+      call check_length('condition', condition, len(spec%condition), ios, message)
+      if (ios /= 0) return
+      spec%point = point
+      spec%normal = normal
+      spec%lower = lower
+      spec%upper = upper
+      spec%condition = lower_case(adjustl(condition))
+   end subroutine read_wall_group
+
+   subroutine read_inlet_group(spec, ios, message, unit, text)
+      type(inlet_spec_t), intent(inout) :: spec
+      integer, intent(out) :: ios
+      character(len=*), intent(inout) :: message
+      integer, intent(in), optional :: unit
+      character(len=*), intent(in), optional :: text
+      character(len=text_len) :: material
+      real(rp) :: point(3), direction(3), height, width, velocity, start_time, end_time
+      integer :: particles_per_cell
+      logical :: hydrostatic
+      namelist /inlet/ material, point, direction, height, width, velocity, start_time, end_time, &
+         particles_per_cell, hydrostatic
+
+      material = spec%material
+      point = spec%point
+      direction = spec%direction
+      height = spec%height
+      width = spec%width
+      velocity = spec%velocity
+      start_time = spec%start_time
+      end_time = spec%end_time
+      particles_per_cell = spec%particles_per_cell
+      hydrostatic = spec%hydrostatic
+      if (present(text)) then
+         read (text, nml=inlet, iostat=ios, iomsg=message)
+      else
+         read (unit, nml=inlet, iostat=ios, iomsg=message)
+      end if
+      call check_length('material', material, len(spec%material), ios, message)
+      if (ios /= 0) return
+      spec%material = material(1:len(spec%material))
+      spec%point = point
+      spec%direction = direction
+      spec%height = height
+      spec%width = width
+      spec%velocity = velocity
+      spec%start_time = start_time
+      spec%end_time = end_time
+      spec%particles_per_cell = particles_per_cell
+      spec%hydrostatic = hydrostatic
+   end subroutine read_inlet_group
 end module scene_reader

@@ -5,8 +5,9 @@ module scene_validation
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use kinds, only: rp, i8, name_len
    use error_status, only: status_t
-   use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, &
-                                wall_none, wall_slip, wall_no_slip, model_newtonian_fluid, model_linear_elastic
+   use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
+                                inlet_spec_t, wall_none, wall_slip, wall_no_slip, model_newtonian_fluid, &
+                                model_linear_elastic
    use input_text, only: int_text, real_text, quoted_list, group_context, ordinal
    implicit none
    private
@@ -22,6 +23,8 @@ module scene_validation
    character(len=*), parameter, public :: update_scheme_keywords(*) = [character(len=4) :: 'USL', 'MUSL']
    !> Accepted `&box_walls` keywords (stored lower case).
    character(len=*), parameter, public :: wall_keywords(*) = [character(len=7) :: wall_none, wall_slip, wall_no_slip]
+   !> Accepted `&wall condition=` keywords (stored lower case).
+   character(len=*), parameter, public :: wall_condition_keywords(*) = [character(len=7) :: wall_slip, wall_no_slip]
    !> Accepted `&material model=` keywords (stored lower case).
    character(len=*), parameter, public :: model_keywords(*) = &
       [character(len=15) :: model_newtonian_fluid, model_linear_elastic]
@@ -44,7 +47,7 @@ contains
       type(scene_t), intent(in) :: scene
       character(len=*), intent(in) :: path
       type(status_t), intent(inout) :: status
-      integer :: m, b
+      integer :: m, b, w, i
 
       call validate_run(scene%run, path, status)
       if (status%ok) call validate_grid(scene%grid, path, status)
@@ -63,23 +66,46 @@ contains
          if (.not. status%ok) return
       end do
 
-      if (.not. allocated(scene%bodies)) then
-         call status%fail(trim(path)//': at least one group &body is required')
-      else if (size(scene%bodies) == 0) then
-         call status%fail(trim(path)//': at least one group &body is required')
+      ! something must bring material into the scene
+      if (body_count(scene) == 0 .and. inlet_count(scene) == 0) then
+         call status%fail(trim(path)//': at least one group &body or &inlet is required')
+         return
       end if
-      if (.not. status%ok) return
-      do b = 1, size(scene%bodies)
+      do b = 1, body_count(scene)
          call validate_body(scene%bodies(b), b, scene%materials, scene%grid, path, status)
          if (.not. status%ok) return
       end do
+      if (allocated(scene%walls)) then
+         do w = 1, size(scene%walls)
+            call validate_wall(scene%walls(w), w, scene%grid%dim, path, status)
+            if (.not. status%ok) return
+         end do
+      end if
+      if (allocated(scene%inlets)) then
+         do i = 1, size(scene%inlets)
+            call validate_inlet(scene%inlets(i), i, scene%materials, scene%grid, path, status)
+            if (.not. status%ok) return
+         end do
+      end if
    end subroutine validate_scene
+
+   pure integer function body_count(scene)
+      type(scene_t), intent(in) :: scene
+      body_count = 0
+      if (allocated(scene%bodies)) body_count = size(scene%bodies)
+   end function body_count
+
+   pure integer function inlet_count(scene)
+      type(scene_t), intent(in) :: scene
+      inlet_count = 0
+      if (allocated(scene%inlets)) inlet_count = size(scene%inlets)
+   end function inlet_count
 
    !> Replace the "0 = derived" defaults by their values and fill the derived fields. Call once, on a
    !> scene that `validate_scene` accepted.
    subroutine resolve_scene(scene)
       type(scene_t), intent(inout) :: scene
-      integer :: k, b
+      integer :: k, b, w, i
 
       associate (run => scene%run, grid => scene%grid)
          ! Validated >= 0, so not > 0 means 0.
@@ -90,8 +116,22 @@ contains
             grid%ncells(k) = nint(grid%extent(k) / grid%cell_size)
          end do
       end associate
+      if (.not. allocated(scene%bodies)) allocate (scene%bodies(0))
       do b = 1, size(scene%bodies)
          scene%bodies(b)%material_index = find_material(scene%materials, scene%bodies(b)%material)
+      end do
+      if (.not. allocated(scene%walls)) allocate (scene%walls(0))
+      do w = 1, size(scene%walls)
+         associate (normal => scene%walls(w)%normal(1:scene%grid%dim))
+            normal = normal / norm2(normal)
+         end associate
+      end do
+      if (.not. allocated(scene%inlets)) allocate (scene%inlets(0))
+      do i = 1, size(scene%inlets)
+         associate (inlet => scene%inlets(i))
+            inlet%material_index = find_material(scene%materials, inlet%material)
+            inlet%direction(1:scene%grid%dim) = inlet%direction(1:scene%grid%dim) / norm2(inlet%direction(1:scene%grid%dim))
+         end associate
       end do
    end subroutine resolve_scene
 
@@ -163,6 +203,7 @@ contains
       do k = 1, grid%dim
          call check_real(where, 'extent('//int_text(k)//')', grid%extent(k), status, greater_than=0.0_rp)
       end do
+      call check_real(where, 'rotation', grid%rotation, status, at_least=-360.0_rp, at_most=360.0_rp)
       if (.not. status%ok) return
 
       total_cells = 1.0_rp
@@ -344,6 +385,110 @@ contains
          if (.not. status%ok) return
       end do
    end subroutine validate_body
+
+   subroutine validate_wall(wall, w, dim, path, status)
+      type(wall_spec_t), intent(in) :: wall
+      integer, intent(in) :: w, dim
+      character(len=*), intent(in) :: path
+      type(status_t), intent(inout) :: status
+      character(len=:), allocatable :: where
+      integer :: k
+
+      where = group_context(path, 'wall', w)
+      do k = 1, dim
+         call check_real(where, 'point('//int_text(k)//')', wall%point(k), status)
+         call check_real(where, 'normal('//int_text(k)//')', wall%normal(k), status)
+         call check_real(where, 'lower('//int_text(k)//')', wall%lower(k), status)
+         call check_real(where, 'upper('//int_text(k)//')', wall%upper(k), status)
+      end do
+      if (.not. status%ok) return
+      if (norm2(wall%normal(1:dim)) < tiny(1.0_rp)**0.25_rp) then
+         call status%fail(where//': variable normal must not be zero: it points from the wall into the fluid')
+         return
+      end if
+      do k = 1, dim
+         if (wall%upper(k) < wall%lower(k)) then
+            call status%fail(where//': variable upper('//int_text(k)//') must be >= lower('//int_text(k)//') = '// &
+                             real_text(wall%lower(k))//', got '//real_text(wall%upper(k)))
+         else if (wall%point(k) < wall%lower(k) .or. wall%point(k) > wall%upper(k)) then
+            call status%fail(where//': variable point('//int_text(k)//') must lie in the extent of the wall, lower('// &
+                             int_text(k)//') .. upper('//int_text(k)//') = '//real_text(wall%lower(k))//' .. '// &
+                             real_text(wall%upper(k))//', got '//real_text(wall%point(k)))
+         end if
+         if (.not. status%ok) return
+      end do
+      if (all(wall%condition /= wall_condition_keywords)) then
+         call status%fail(where//': variable condition must be one of '//quoted_list(wall_condition_keywords)// &
+                          ", got '"//trim(wall%condition)//"'")
+      end if
+   end subroutine validate_wall
+
+   subroutine validate_inlet(inlet, i, materials, grid, path, status)
+      type(inlet_spec_t), intent(in) :: inlet
+      integer, intent(in) :: i
+      type(material_spec_t), intent(in) :: materials(:)
+      type(grid_spec_t), intent(in) :: grid
+      character(len=*), intent(in) :: path
+      type(status_t), intent(inout) :: status
+      character(len=:), allocatable :: where
+      real(rp) :: direction(3), tangent(3), far_end(3), tolerance
+      integer :: k, m, dim
+
+      dim = grid%dim
+      where = group_context(path, 'inlet', i, "material '"//trim(inlet%material)//"'")
+      m = find_material(materials, inlet%material)
+      if (m == 0) then
+         call status%fail(where//': variable material must name a declared &material, got '''//trim(inlet%material)//"'")
+         return
+      else if (materials(m)%model /= model_newtonian_fluid) then
+         call status%fail(where//": variable material must name a '"//model_newtonian_fluid//"' material, got '"// &
+                          trim(inlet%material)//"' (model '"//trim(materials(m)%model)//"')")
+         return
+      end if
+      do k = 1, dim
+         call check_real(where, 'point('//int_text(k)//')', inlet%point(k), status)
+         call check_real(where, 'direction('//int_text(k)//')', inlet%direction(k), status)
+      end do
+      call check_real(where, 'height', inlet%height, status, greater_than=0.0_rp)
+      if (dim == 3) call check_real(where, 'width', inlet%width, status, greater_than=0.0_rp)
+      call check_real(where, 'velocity', inlet%velocity, status, greater_than=0.0_rp)
+      call check_real(where, 'start_time', inlet%start_time, status, at_least=0.0_rp)
+      call check_real(where, 'end_time', inlet%end_time, status, greater_than=inlet%start_time)
+      if (.not. status%ok) return
+      if (inlet%particles_per_cell < 1) then
+         call status%fail(where//': variable particles_per_cell must be >= 1, got '//int_text(inlet%particles_per_cell))
+         return
+      end if
+      if (norm2(inlet%direction(1:dim)) < tiny(1.0_rp)**0.25_rp) then
+         call status%fail(where//': variable direction must not be zero: it is the direction of the inflow')
+         return
+      end if
+      if (dim == 3 .and. abs(inlet%direction(3)) > 0.0_rp) then
+         call status%fail(where//': variable direction(3) must be 0 (the opening spans height in the x-y plane and '// &
+                          'width along z), got '//real_text(inlet%direction(3)))
+         return
+      end if
+      ! both ends of the opening must lie in the scene box
+      direction = 0.0_rp
+      direction(1:dim) = inlet%direction(1:dim) / norm2(inlet%direction(1:dim))
+      tangent = [-direction(2), direction(1), 0.0_rp]
+      far_end = inlet%point + inlet%height * tangent
+      if (dim == 3) far_end(3) = far_end(3) + inlet%width
+      tolerance = inside_tolerance * grid%cell_size
+      do k = 1, dim
+         if (inlet%point(k) < grid%origin(k) - tolerance .or. &
+             inlet%point(k) > grid%origin(k) + grid%extent(k) + tolerance) then
+            call status%fail(where//': variable point('//int_text(k)//') must lie in the scene box of &grid, '// &
+                             real_text(grid%origin(k))//' .. '//real_text(grid%origin(k) + grid%extent(k))//', got '// &
+                             real_text(inlet%point(k)))
+         else if (far_end(k) < grid%origin(k) - tolerance .or. &
+                  far_end(k) > grid%origin(k) + grid%extent(k) + tolerance) then
+            call status%fail(where//': variables point, direction, height and width put the far end of the opening '// &
+                             'outside the scene box of &grid ('//axis_letter(k)//' = '//real_text(far_end(k))//')')
+         end if
+         if (.not. status%ok) return
+      end do
+   end subroutine validate_inlet
 
    !> Fail with "<where>: variable <variable> must be <range>, got <value>" unless `value` is finite and
    !> inside the range given by the optional bounds.

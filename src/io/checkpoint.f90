@@ -19,6 +19,7 @@ module checkpoint
    use error_status, only: status_t
    use scene_description, only: scene_t
    use mpm_solver, only: solver_t
+   use world_frame, only: frame_t, place_grid
    use particle_sorting, only: update_cells, sort_by_material_and_cell
    use particle_redistribution, only: redistribute_particles
    use hdf5_file, only: hdf5_file_t, slab_t, distributed_slab, even_slab
@@ -33,7 +34,7 @@ module checkpoint
 
    !> Identification of the file format; a reader accepts exactly this version.
    character(len=*), parameter, public :: checkpoint_format = 'flotsam checkpoint'
-   integer, parameter, public :: checkpoint_format_version = 1
+   integer, parameter, public :: checkpoint_format_version = 2   ! 2: grid rotation
 
    public :: write_checkpoint, read_checkpoint, latest_checkpoint_path
 
@@ -63,6 +64,7 @@ contains
       call file%write_attribute('cells', solver%grid%global_cells, status)
       call file%write_attribute('origin', solver%grid%origin, status)
       call file%write_attribute('cell_size', solver%grid%h, status)
+      call file%write_attribute('rotation', solver%grid%frame%rotation_degrees, status)
       call file%write_attribute('materials', size(solver%materials), status)
       do m = 1, size(solver%materials)
          call file%write_attribute('material_'//int_text(m), solver%materials(m)%model%name, status)
@@ -347,26 +349,31 @@ contains
       character(len=*), intent(in) :: where
       type(status_t), intent(inout) :: status
       integer :: dim, cells(3), n_materials, m
-      real(rp) :: origin(3), cell_size
+      real(rp) :: origin(3), cell_size, rotation, grid_origin(3)
+      integer :: grid_cells(3)
+      type(frame_t) :: frame
       character(len=64) :: name
       real(rp), parameter :: same = 1.0e-12_rp     ! relative to the cell size: round-off only
       dim = 0
       cells = 0
       origin = 0.0_rp
       cell_size = 0.0_rp
+      rotation = 0.0_rp
       n_materials = 0
       call file%read_attribute('dim', dim, status)
       call file%read_attribute('cells', cells, status)
       call file%read_attribute('origin', origin, status)
       call file%read_attribute('cell_size', cell_size, status)
+      call file%read_attribute('rotation', rotation, status)
       call file%read_attribute('materials', n_materials, status)
       if (.not. status%ok) return
+      call place_grid(scene%grid, frame, grid_origin, grid_cells)
       if (dim /= scene%grid%dim) then
          call status%fail(where//' was written for a '//int_text(dim)//'-D scene, this scene is '// &
                           int_text(scene%grid%dim)//'-D')
-      else if (any(cells /= scene%grid%ncells) .or. any(abs(origin - scene%grid%origin) > same * cell_size) .or. &
-               abs(cell_size - scene%grid%cell_size) > same * cell_size) then
-         call status%fail(where//' was written for another grid (&grid cell_size, origin or extent differ)')
+      else if (any(cells /= grid_cells) .or. any(abs(origin - grid_origin) > same * cell_size) .or. &
+               abs(cell_size - scene%grid%cell_size) > same * cell_size .or. abs(rotation - scene%grid%rotation) > 0.0_rp) then
+         call status%fail(where//' was written for another grid (&grid cell_size, origin, extent or rotation differ)')
       else if (n_materials /= size(scene%materials)) then
          call status%fail(where//' was written for '//int_text(n_materials)//' materials, the scene has '// &
                           int_text(size(scene%materials)))

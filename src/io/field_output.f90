@@ -17,7 +17,6 @@ module field_output
    use mpi_f08, only: MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER, MPI_LOGICAL, MPI_MIN, MPI_MAX, MPI_LAND
    use tensor_layout, only: mean_stress
    use background_grid, only: row_mass
-   use world_frame, only: grid_to_world, grid_to_world_vectors, grid_to_world_tensors
    use grid_transfer, only: particles_to_grid
    use node_halo, only: sum_shared_nodes
    use mpm_solver, only: solver_t
@@ -86,9 +85,9 @@ contains
       associate (particles => solver%particles)
          allocate (vectors(3, max(n, 1)), tensors(9, max(n, 1)), scalars(max(n, 1)), integers(max(n, 1)), &
                    ids(max(n, 1)))
-         call grid_to_world(particles%x(:, 1:n), vectors)
+         call solver%grid%frame%to_world_points(particles%x(:, 1:n), vectors)
          call file%write_slab('particles/position', slab, vectors, status)
-         call grid_to_world_vectors(particles%v(:, 1:n), vectors)
+         call solver%grid%frame%to_world_vectors(particles%v(:, 1:n), vectors)
          call file%write_slab('particles/velocity', slab, vectors, status)
          scalars(1:n) = particles%mass(1:n)
          call file%write_slab('particles/mass', slab, scalars, status)
@@ -104,7 +103,7 @@ contains
          do p = 1, n
             sigma(:, p) = particles%density(p) * particles%sbar(:, p)
          end do
-         call grid_to_world_tensors(sigma(:, 1:n), particles%dim, tensors)
+         call solver%grid%frame%to_world_tensors(sigma(:, 1:n), particles%dim, tensors)
          call file%write_slab('particles/stress', slab, tensors, status)
          integers(1:n) = particles%material(1:n)
          call file%write_slab('particles/material', slab, integers, status)
@@ -128,7 +127,8 @@ contains
       type(status_t), intent(inout) :: status
       integer :: box_lo(3), box_hi(3), cell_lo(3), cell_hi(3), node_hi(3), dim, m, k
       integer(i8) :: cells(3), nodes(3), local_cells(3), local_nodes(3), offset(3)
-      real(rp), allocatable :: node_mass(:), node_velocity(:, :), density(:), stress(:), corner(:, :)
+      real(rp), allocatable :: node_mass(:), node_velocity(:, :), density(:), stress(:), corner(:, :), &
+                               node_position(:, :)
       real(rp) :: world_corner(3, 1)
       character(len=:), allocatable :: name
 
@@ -143,7 +143,7 @@ contains
       entry%grid_origin = 0.0_rp
       entry%grid_origin(1:dim) = solver%grid%origin(1:dim) + box_lo(1:dim) * solver%grid%h
       corner(:, 1) = entry%grid_origin(1:dim)
-      call grid_to_world(corner, world_corner)
+      call solver%grid%frame%to_world_points(corner, world_corner)
       entry%grid_origin = world_corner(:, 1)
 
       ! this rank's cells and nodes inside the box
@@ -174,6 +174,12 @@ contains
       call file%write_block('grid/node/mass', nodes, offset, local_nodes, node_mass, status)
       call file%write_block('grid/node/velocity', [3_i8, nodes], [0_i8, offset], [3_i8, local_nodes], &
                             reshape(node_velocity, [size(node_velocity)]), status)
+      ! a rotated grid is not a rectilinear mesh in the world: its node positions go into the file
+      if (solver%grid%frame%rotated) then
+         call node_positions(solver, cell_lo, node_hi, local_nodes, node_position)
+         call file%write_block('grid/node/position', [3_i8, nodes], [0_i8, offset], [3_i8, local_nodes], &
+                               reshape(node_position, [size(node_position)]), status)
+      end if
       do m = 1, size(solver%materials)
          call cell_averages(solver, m, cell_lo, local_cells, density, stress)
          name = material_field_name(solver, m)
@@ -226,6 +232,32 @@ contains
       box_hi(dim + 1:) = 0
    end subroutine active_box
 
+   !> World positions of the nodes cell_lo..node_hi, x fastest.
+   subroutine node_positions(solver, cell_lo, node_hi, local_nodes, position)
+      type(solver_t), intent(in) :: solver
+      integer, intent(in) :: cell_lo(3), node_hi(3)
+      integer(i8), intent(in) :: local_nodes(3)
+      real(rp), allocatable, intent(out) :: position(:, :)
+      real(rp), allocatable :: grid_position(:, :)
+      integer :: i, j, l, n, dim
+      dim = solver%grid%dim
+      n = int(product(local_nodes))
+      allocate (position(3, max(n, 1)), grid_position(dim, max(n, 1)))
+      grid_position = 0.0_rp
+      if (n > 0) then
+         n = 0
+         do l = cell_lo(3), node_hi(3)
+            do j = cell_lo(2), node_hi(2)
+               do i = cell_lo(1), node_hi(1)
+                  n = n + 1
+                  grid_position(:, n) = solver%grid%origin(1:dim) + [i, j, l] * solver%grid%h
+               end do
+            end do
+         end do
+      end if
+      call solver%grid%frame%to_world_points(grid_position, position)
+   end subroutine node_positions
+
    !> Mass and velocity P/m (0 on empty nodes) of the nodes cell_lo..node_hi, x fastest.
    subroutine nodal_fields(solver, cell_lo, node_hi, local_nodes, mass, velocity)
       type(solver_t), intent(in) :: solver
@@ -254,7 +286,7 @@ contains
             end do
          end do
       end if
-      call grid_to_world_vectors(grid_velocity, velocity)
+      call solver%grid%frame%to_world_vectors(grid_velocity, velocity)
    end subroutine nodal_fields
 
    !> Volume-weighted cell averages of material m over the local_cells from cell_lo (x fastest): density

@@ -71,15 +71,21 @@ contains
    end subroutine write_particles_xdmf
 
    !> Write the grid time series of `entries` (grid box of each, spacing h) with `attributes` to `path`.
-   subroutine write_grid_xdmf(path, entries, attributes, dim, h, status)
+   !> With node_positions (a grid rotated against the world) the mesh is a 3DSMesh whose node positions
+   !> are the dataset /grid/node/position.
+   subroutine write_grid_xdmf(path, entries, attributes, dim, h, status, node_positions)
       character(len=*), intent(in) :: path
       type(output_entry_t), intent(in) :: entries(:)
       type(xdmf_attribute_t), intent(in) :: attributes(:)
       integer, intent(in) :: dim
       real(rp), intent(in) :: h
       type(status_t), intent(inout) :: status
+      logical, intent(in), optional :: node_positions
+      logical :: explicit
       integer :: unit, e, a, nodes(3)
       character(len=:), allocatable :: node_dims, cell_dims, file
+      explicit = .false.
+      if (present(node_positions)) explicit = node_positions
       call open_xdmf(path, 'grid', unit, status)
       if (.not. status%ok) return
       do e = 1, size(entries)
@@ -92,6 +98,12 @@ contains
          end associate
          file = fields_file(entries(e)%index)
          call begin_step(unit, 'grid', entries(e))
+         if (explicit) then
+            write (unit, '(a)') '        <Topology TopologyType="3DSMesh" Dimensions="'//node_dims//'"/>', &
+               '        <Geometry GeometryType="XYZ">', &
+               '          '//data_item(node_dims//' 3', .false., 8, file//':/grid/node/position'), &
+               '        </Geometry>'
+         else
          write (unit, '(a)') '        <Topology TopologyType="3DCoRectMesh" Dimensions="'//node_dims//'"/>', &
             '        <Geometry GeometryType="ORIGIN_DXDYDZ">', &
             '          <DataItem Dimensions="3" NumberType="Float" Precision="8" Format="XML">'// &
@@ -100,6 +112,7 @@ contains
             '          <DataItem Dimensions="3" NumberType="Float" Precision="8" Format="XML">'// &
             real_text(h)//' '//real_text(h)//' '//real_text(h)//'</DataItem>', &
             '        </Geometry>'
+         end if
          do a = 1, size(attributes)
             if (attributes(a)%center == 'Cell') then
                call write_attribute(unit, attributes(a), cell_dims, file)

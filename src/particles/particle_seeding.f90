@@ -3,8 +3,10 @@
 !>
 !> A body spans lower..upper; along axis k it holds n_k = nint((upper_k - lower_k) / (h / ppc))
 !> particles at spacing (upper_k - lower_k) / n_k, centred in their lattice cells, so the body's mass
-!> is exactly rho0 times its volume. Particle ids are body offset + lattice index: they do not depend
-!> on the number of ranks.
+!> is exactly rho0 times its volume. Bodies are given in the world frame: the lattice is the body's
+!> (on a rotated grid cells hold unequal particle counts, as in [Y17]'s 45 degree test), positions and
+!> velocities are mapped into the grid frame. Particle ids are body offset + lattice index: they do not
+!> depend on the number of ranks.
 module particle_seeding
    use kinds, only: rp, i8
    use scene_description, only: scene_t, body_spec_t
@@ -15,7 +17,7 @@ module particle_seeding
    implicit none
    private
 
-   public :: lattice_counts, seed_bodies
+   public :: lattice_counts, seed_bodies, body_particle_count
 
 contains
 
@@ -29,6 +31,16 @@ contains
       n(1:dim) = nint((body%upper(1:dim) - body%lower(1:dim)) / (cell_size / body%particles_per_cell))
    end function lattice_counts
 
+   !> Number of particles of all bodies of the scene (over all ranks): the first id free for others.
+   pure integer(i8) function body_particle_count(scene) result(total)
+      type(scene_t), intent(in) :: scene
+      integer :: b
+      total = 0
+      do b = 1, size(scene%bodies)
+         total = total + product(int(lattice_counts(scene%bodies(b), scene%grid%dim, scene%grid%cell_size), i8))
+      end do
+   end function body_particle_count
+
    !> Create this rank's particles of every body of the scene.
    subroutine seed_bodies(scene, grid, domain, particles)
       type(scene_t), intent(in) :: scene
@@ -37,7 +49,7 @@ contains
       type(particle_set_t), intent(inout) :: particles
       integer :: b, dim, n(3), i, j, l, c(3)
       integer(i8) :: id_offset
-      real(rp) :: spacing(3), x(3), particle_volume, up(3), g_norm, pressure, density
+      real(rp) :: spacing(3), x(3), particle_volume, up(3), g_norm, pressure, density, x_grid(3), v_grid(3)
       real(rp), allocatable :: sbar(:)
 
       dim = grid%dim
@@ -53,11 +65,15 @@ contains
             spacing(1:dim) = (body%upper(1:dim) - body%lower(1:dim)) / n(1:dim)
             particle_volume = product(spacing(1:dim))
             density = scene%materials(body%material_index)%density
+            v_grid = 0.0_rp
+            v_grid(1:dim) = grid%frame%grid_vector(body%velocity(1:dim))
+            x_grid = 0.0_rp
             do l = 0, n(3) - 1
                do j = 0, n(2) - 1
                   do i = 0, n(1) - 1
                      x = body%lower + ([i, j, l] + 0.5_rp) * spacing
-                     c = grid%cell_of_position(x(1:dim))
+                     x_grid(1:dim) = grid%frame%grid_point(x(1:dim))
+                     c = grid%cell_of_position(x_grid(1:dim))
                      if (.not. domain%owns_cell(c(1:dim))) cycle
                      sbar = 0.0_rp
                      if (body%hydrostatic) then
@@ -65,7 +81,7 @@ contains
                         pressure = density * g_norm * max(0.0_rp, body%free_surface_level - dot_product(up(1:dim), x(1:dim)))
                         sbar(1:3) = -pressure / density
                      end if
-                     call particles%add(x(1:dim), body%velocity(1:dim), density * particle_volume, density, sbar, &
+                     call particles%add(x_grid(1:dim), v_grid(1:dim), density * particle_volume, density, sbar, &
                                         body%material_index, id_offset + i + int(n(1), i8) * (j + int(n(2), i8) * l))
                   end do
                end do

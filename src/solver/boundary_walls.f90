@@ -1,77 +1,174 @@
-!> Rigid walls: nodal velocity constraints and the particle safeguard (algorithms.md section 4).
+!> Rigid walls: nodal velocity constraints and the particle safeguard (algorithms.md sections 4.1-4.2).
 !>
-!> A wall is a plane with a unit normal pointing into the domain. `slip` is the paper's eq. 14:
-!> unilateral and frictionless, v := v - (v.n) n only where v.n < 0. `no_slip` sets v := 0.
-!> The box walls of `&box_walls` lie on the grid's outer node planes, so there the constrained nodes
-!> are exactly the nodes on the wall.
+!> A wall is the part of a plane (point x_w, unit normal n_w pointing into the fluid) inside a world-frame
+!> box, its extent. Its signed distance is phi(x) = n_w . (x - x_w). The nodes it constrains are found
+!> once, by signed distance [R]: nodes with -depth <= phi <= 0 (on the wall or behind it, within two
+!> cells) whose foot point x - phi n_w lies in the extent widened by `margin` (h for walls, the cells cut
+!> by the wall's ends). On an aligned grid these are exactly the nodes on the wall's grid line.
+!>   slip       [Y17] eq. 14, unilateral and frictionless: v := v - (v.n) n only where v.n < 0
+!>   no_slip    v := 0
+!>   prescribed v := v_0 (the feeder of an inlet, algorithms.md section 4.3)
+!> A wall may be active for a time window only (an inlet's opening and its closing wall).
 module boundary_walls
-   use kinds, only: rp, name_len
-   use scene_description, only: grid_spec_t, wall_none, wall_slip, wall_no_slip
+   use kinds, only: rp
+   use scene_description, only: wall_spec_t, grid_spec_t, wall_none, wall_no_slip
    use background_grid, only: grid_t
    use particle_set, only: particle_set_t
    implicit none
    private
 
+   integer, parameter, public :: wall_kind_slip = 1, wall_kind_no_slip = 2, wall_kind_prescribed = 3
+   !> Nodes and particles farther behind a wall than this many cells are not its business [R]: a
+   !> particle in a cell cut by the wall reaches nodes at most sqrt(dim) h behind it, and a baffle made of
+   !> two walls back to back must not constrain the far side.
+   real(rp), parameter :: depth_in_cells = 2.0_rp
+   !> A node closer to the wall than this fraction of h counts as on it (round-off of node positions).
+   real(rp), parameter :: on_wall_tolerance = 1.0e-9_rp
+
    type, public :: wall_t
-      real(rp) :: normal(3) = 0.0_rp       !< unit normal pointing into the domain
+      real(rp) :: normal(3) = 0.0_rp       !< unit normal pointing into the fluid (grid frame)
       real(rp) :: point(3) = 0.0_rp        !< a point on the wall (grid frame)
-      logical :: no_slip = .false.
-      integer :: axis = 0                  !< k if the normal is +-e_k (box walls), else 0
+      real(rp) :: lower(3) = -huge(1.0_rp) !< extent: world-frame bounding box of the wall
+      real(rp) :: upper(3) = huge(1.0_rp)
+      real(rp) :: margin = 0.0_rp          !< tolerance of the extent test [m]
+      real(rp) :: depth = 0.0_rp           !< how far behind the wall it acts [m]
+      integer :: kind = wall_kind_slip
+      real(rp) :: velocity(3) = 0.0_rp     !< prescribed velocity (grid frame)
+      real(rp) :: active_from = -huge(1.0_rp), active_until = huge(1.0_rp)
+      logical :: active = .true.
+      integer :: axis = 0                  !< k if the grid-frame normal is +-e_k, else 0
       integer, allocatable :: nodes(:)     !< local nodes this rank constrains
    end type wall_t
 
-   public :: build_box_walls, apply_wall_constraints, keep_particles_inside
+   public :: build_walls, make_wall, set_wall_activity, apply_wall_constraints, keep_particles_inside
 
 contains
 
-   !> One wall per box side that is not `none`, with the local nodes lying on it.
-   subroutine build_box_walls(spec, grid, walls)
+   !> The walls of `&wall` groups (`specs`) and of the `&box_walls` sides of `spec`, with their local nodes.
+   subroutine build_walls(specs, spec, grid, walls)
+      type(wall_spec_t), intent(in) :: specs(:)
       type(grid_spec_t), intent(in) :: spec
       type(grid_t), intent(in) :: grid
       type(wall_t), allocatable, intent(out) :: walls(:)
-      type(wall_t) :: wall
-      integer :: k, side, plane, i, j, l, n, g(3), extent(3)
-      character(len=name_len) :: condition
+      type(wall_spec_t), allocatable :: all_specs(:)
+      all_specs = [specs, box_side_walls(spec)]
+      call build_walls_of(all_specs, grid, walls)
+   end subroutine build_walls
 
+   subroutine build_walls_of(specs, grid, walls)
+      type(wall_spec_t), intent(in) :: specs(:)
+      type(grid_t), intent(in) :: grid
+      type(wall_t), allocatable, intent(out) :: walls(:)
+      integer :: w, kind
+      allocate (walls(size(specs)))
+      do w = 1, size(specs)
+         kind = wall_kind_slip
+         if (specs(w)%condition == wall_no_slip) kind = wall_kind_no_slip
+         walls(w) = make_wall(grid, specs(w)%point, specs(w)%normal, specs(w)%lower, specs(w)%upper, grid%h, kind)
+      end do
+   end subroutine build_walls_of
+
+   !> The sides of the scene box that `&box_walls` makes walls, as `&wall` entries: each is the face of
+   !> the box lower..lower + ncells h (world frame), with the normal pointing into the box.
+   pure function box_side_walls(grid) result(walls)
+      type(grid_spec_t), intent(in) :: grid
+      type(wall_spec_t), allocatable :: walls(:)
+      type(wall_spec_t) :: wall
+      real(rp) :: upper(3)
+      integer :: k, side
       allocate (walls(0))
+      upper = grid%origin + grid%ncells * grid%cell_size
       do k = 1, grid%dim
          do side = 1, 2
-            condition = spec%wall(side, k)
-            if (condition == wall_none) cycle
+            if (grid%wall(side, k) == wall_none) cycle
+            wall%condition = grid%wall(side, k)
             wall%normal = 0.0_rp
             wall%normal(k) = merge(1.0_rp, -1.0_rp, side == 1)
+            wall%lower = grid%origin
+            wall%upper = upper
             wall%point = grid%origin
-            plane = merge(0, grid%global_cells(k), side == 1)
-            wall%point(k) = grid%origin(k) + plane * grid%h
-            wall%no_slip = condition == wall_no_slip
-            wall%axis = k
-            if (condition /= wall_slip .and. condition /= wall_no_slip) cycle
-            if (plane < grid%node_lo(k) .or. plane > grid%node_hi(k)) then
-               allocate (wall%nodes(0))
-            else
-               extent = grid%n_nodes
-               extent(k) = 1
-               allocate (wall%nodes(product(extent)))
-               n = 0
-               do l = 0, extent(3) - 1
-                  do j = 0, extent(2) - 1
-                     do i = 0, extent(1) - 1
-                        g = grid%node_lo + [i, j, l]
-                        g(k) = plane
-                        n = n + 1
-                        wall%nodes(n) = grid%local_node(g(1:grid%dim))
-                     end do
-                  end do
-               end do
-            end if
+            if (side == 2) wall%point(k) = upper(k)
+            wall%lower(k) = wall%point(k)
+            wall%upper(k) = wall%point(k)
             walls = [walls, wall]
-            deallocate (wall%nodes)
          end do
       end do
-   end subroutine build_box_walls
+   end function box_side_walls
 
-   !> Constrain nodal velocities (eq. 14 for slip walls; zero for no-slip walls). Walls are applied in
-   !> turn, which is exact at a corner of two orthogonal walls (algorithms.md section 4.1).
+   !> A wall through the world point `point` with the world unit normal `normal`, its extent lower..upper
+   !> (world) widened by `margin`, and the local nodes it constrains.
+   function make_wall(grid, point, normal, lower, upper, margin, kind, velocity, active_from, active_until) result(wall)
+      type(grid_t), intent(in) :: grid
+      real(rp), intent(in) :: point(3), normal(3), lower(3), upper(3), margin
+      integer, intent(in) :: kind
+      real(rp), intent(in), optional :: velocity(3), active_from, active_until
+      type(wall_t) :: wall
+      integer :: dim, n, i, j, l, g(3)
+      integer, allocatable :: found(:)
+      real(rp) :: x(3)
+
+      dim = grid%dim
+      wall%point = 0.0_rp
+      wall%normal = 0.0_rp
+      wall%point(1:dim) = grid%frame%grid_point(point(1:dim))
+      wall%normal(1:dim) = grid%frame%grid_vector(normal(1:dim) / norm2(normal(1:dim)))
+      wall%lower = lower
+      wall%upper = upper
+      wall%margin = margin
+      wall%depth = depth_in_cells * grid%h
+      wall%kind = kind
+      if (present(velocity)) wall%velocity(1:dim) = grid%frame%grid_vector(velocity(1:dim))
+      if (present(active_from)) wall%active_from = active_from
+      if (present(active_until)) wall%active_until = active_until
+      ! the axis fast path of the safeguard needs a normal with exactly one non-zero component
+      if (count(abs(wall%normal(1:dim)) > 0.0_rp) == 1) wall%axis = maxloc(abs(wall%normal(1:dim)), 1)
+
+      allocate (found(grid%node_count))
+      n = 0
+      x = 0.0_rp
+      do l = grid%node_lo(3), grid%node_hi(3)
+         do j = grid%node_lo(2), grid%node_hi(2)
+            do i = grid%node_lo(1), grid%node_hi(1)
+               g = [i, j, l]
+               x(1:dim) = grid%origin(1:dim) + g(1:dim) * grid%h
+               if (.not. behind_wall(wall, grid, x(1:dim), on_wall_tolerance * grid%h)) cycle
+               n = n + 1
+               found(n) = grid%local_node(g(1:dim))
+            end do
+         end do
+      end do
+      wall%nodes = found(1:n)
+   end function make_wall
+
+   !> True if the grid-frame point x lies on the wall or behind it (within `tolerance` in front), not
+   !> farther behind than the wall's depth, with its foot point inside the wall's extent.
+   logical function behind_wall(wall, grid, x, tolerance) result(behind)
+      type(wall_t), intent(in) :: wall
+      type(grid_t), intent(in) :: grid
+      real(rp), intent(in) :: x(:), tolerance
+      real(rp) :: distance, foot(size(x))
+      integer :: d
+      d = size(x)
+      distance = dot_product(wall%normal(1:d), x - wall%point(1:d))
+      behind = distance <= tolerance .and. distance >= -wall%depth
+      if (.not. behind) return
+      foot = grid%frame%world_point(x - distance * wall%normal(1:d))
+      behind = all(foot >= wall%lower(1:d) - wall%margin) .and. all(foot <= wall%upper(1:d) + wall%margin)
+   end function behind_wall
+
+   !> Walls act during [active_from, active_until) only.
+   pure subroutine set_wall_activity(walls, time)
+      type(wall_t), intent(inout) :: walls(:)
+      real(rp), intent(in) :: time
+      integer :: w
+      do w = 1, size(walls)
+         walls(w)%active = time >= walls(w)%active_from .and. time < walls(w)%active_until
+      end do
+   end subroutine set_wall_activity
+
+   !> Constrain nodal velocities (eq. 14 for slip walls; zero for no-slip walls; v_0 for a feeder).
+   !> Walls are applied in turn, which is exact at a corner of two orthogonal walls (algorithms.md
+   !> section 4.1); a prescribed velocity, listed last, wins.
    pure subroutine apply_wall_constraints(walls, dim, velocity)
       type(wall_t), intent(in) :: walls(:)
       integer, intent(in) :: dim
@@ -79,51 +176,62 @@ contains
       integer :: w, i, node
       real(rp) :: vn
       do w = 1, size(walls)
+         if (.not. walls(w)%active) cycle
          associate (n => walls(w)%normal(1:dim))
-            do i = 1, size(walls(w)%nodes)
-               node = walls(w)%nodes(i)
-               if (walls(w)%no_slip) then
-                  velocity(:, node) = 0.0_rp
-               else
+            select case (walls(w)%kind)
+            case (wall_kind_no_slip)
+               do i = 1, size(walls(w)%nodes)
+                  velocity(:, walls(w)%nodes(i)) = 0.0_rp
+               end do
+            case (wall_kind_prescribed)
+               do i = 1, size(walls(w)%nodes)
+                  velocity(:, walls(w)%nodes(i)) = walls(w)%velocity(1:dim)
+               end do
+            case default
+               do i = 1, size(walls(w)%nodes)
+                  node = walls(w)%nodes(i)
                   vn = dot_product(velocity(:, node), n)
                   if (vn < 0.0_rp) velocity(:, node) = velocity(:, node) - vn * n
-               end if
-            end do
+               end do
+            end select
          end associate
       end do
    end subroutine apply_wall_constraints
 
-   !> Particle safeguard (algorithms.md section 4.2): a particle found behind a wall is put back onto
-   !> it and loses its velocity component into the wall. Returns how many corrections were made.
-   subroutine keep_particles_inside(walls, particles, corrections)
+   !> Particle safeguard (algorithms.md section 4.2): a particle found behind a wall (inside its extent
+   !> and depth) is put back onto it and loses its velocity component into the wall. Counts corrections.
+   subroutine keep_particles_inside(walls, grid, particles, corrections)
       type(wall_t), intent(in) :: walls(:)
+      type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
       integer, intent(inout) :: corrections
       integer :: w, p, d
       real(rp) :: distance, vn
       d = particles%dim
       do w = 1, size(walls)
+         if (.not. walls(w)%active) cycle
          if (walls(w)%axis > 0) then
-            call keep_inside_axis_wall(walls(w), particles, corrections)
+            call keep_inside_axis_wall(walls(w), grid, particles, corrections)
             cycle
          end if
          associate (n => walls(w)%normal(1:d), x0 => walls(w)%point(1:d))
             do p = 1, particles%count
                distance = dot_product(particles%x(:, p) - x0, n)
-               if (distance < 0.0_rp) then
-                  particles%x(:, p) = particles%x(:, p) - distance * n
-                  vn = dot_product(particles%v(:, p), n)
-                  if (vn < 0.0_rp) particles%v(:, p) = particles%v(:, p) - vn * n
-                  corrections = corrections + 1
-               end if
+               if (distance >= 0.0_rp) cycle
+               if (.not. behind_wall(walls(w), grid, particles%x(:, p), 0.0_rp)) cycle
+               particles%x(:, p) = particles%x(:, p) - distance * n
+               vn = dot_product(particles%v(:, p), n)
+               if (vn < 0.0_rp) particles%v(:, p) = particles%v(:, p) - vn * n
+               corrections = corrections + 1
             end do
          end associate
       end do
    end subroutine keep_particles_inside
 
-   !> The safeguard for a wall normal to axis k: the same operation without the dot products.
-   subroutine keep_inside_axis_wall(wall, particles, corrections)
+   !> The safeguard for a wall normal to grid axis k: the same operation without the dot products.
+   subroutine keep_inside_axis_wall(wall, grid, particles, corrections)
       type(wall_t), intent(in) :: wall
+      type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
       integer, intent(inout) :: corrections
       integer :: p, k
@@ -132,11 +240,11 @@ contains
       sense = wall%normal(k)
       x0 = wall%point(k)
       do p = 1, particles%count
-         if (sense * (particles%x(k, p) - x0) < 0.0_rp) then
-            particles%x(k, p) = x0
-            if (sense * particles%v(k, p) < 0.0_rp) particles%v(k, p) = 0.0_rp
-            corrections = corrections + 1
-         end if
+         if (sense * (particles%x(k, p) - x0) >= 0.0_rp) cycle
+         if (.not. behind_wall(wall, grid, particles%x(:, p), 0.0_rp)) cycle
+         particles%x(k, p) = x0
+         if (sense * particles%v(k, p) < 0.0_rp) particles%v(k, p) = 0.0_rp
+         corrections = corrections + 1
       end do
    end subroutine keep_inside_axis_wall
 end module boundary_walls

@@ -6,17 +6,18 @@
 !>   3. stabilization schemes bin their cells at x^n
 !>   4. grid -> particles: L_p, FLIP/PIC velocity, positions (MUSL: re-map before L)
 !>   5. filter part A (d -> d~), constitutive update per material, filter part B (sbar -> sbar~)
-!>   6. wall safeguard, migration to owning ranks, sort by (material, cell), next dt.
+!>   6. wall safeguard, inflow, migration to owning ranks, sort by (material, cell), next dt.
+!> Everything runs in the grid's frame; the scene (world frame) is mapped into it once, in init.
 module mpm_solver
    use kinds, only: rp, i8
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_MIN
    use error_status, only: status_t
-   use scene_description, only: scene_t, run_control_t
+   use scene_description, only: scene_t, run_control_t, wall_spec_t
    use domain_decomposition, only: domain_t
    use background_grid, only: grid_t, row_mass
    use node_halo, only: sum_shared_nodes
    use particle_set, only: particle_set_t
-   use particle_seeding, only: seed_bodies
+   use particle_seeding, only: seed_bodies, body_particle_count
    use particle_sorting, only: sort_by_material_and_cell, update_cells, set_material_ranges
    use particle_migration, only: migrate_particles
    use material_model, only: material_slot_t
@@ -24,7 +25,9 @@ module mpm_solver
    use newtonian_fluid, only: newtonian_fluid_t
    use stabilizer, only: stabilizer_slot_t, stage_context_t
    use stabilizer_factory, only: build_stabilizers
-   use boundary_walls, only: wall_t, build_box_walls, apply_wall_constraints, keep_particles_inside
+   use boundary_walls, only: wall_t, build_walls, set_wall_activity, apply_wall_constraints, keep_particles_inside
+   use fluid_inflow, only: inlet_t, build_inlets
+   use world_frame, only: frame_t, place_grid
    use grid_transfer, only: particles_to_grid, update_velocity_and_remap, grid_to_particles
    use run_diagnostics, only: diagnostics_t, compute_diagnostics
    use status_broadcast, only: agree_on_status
@@ -36,13 +39,14 @@ module mpm_solver
 
    type, public :: solver_t
       type(run_control_t) :: run
-      real(rp) :: gravity(3) = 0.0_rp
+      real(rp) :: gravity(3) = 0.0_rp           !< grid frame
       type(domain_t) :: domain
       type(grid_t) :: grid
       type(particle_set_t) :: particles
       type(material_slot_t), allocatable :: materials(:)
       type(stabilizer_slot_t), allocatable :: schemes(:)
       type(wall_t), allocatable :: walls(:)
+      type(inlet_t), allocatable :: inlets(:)
       real(rp) :: time = 0.0_rp, dt = 0.0_rp
       integer(i8) :: step = 0
       integer :: lost_particles = 0             !< local count of particles that left the grid
@@ -70,19 +74,32 @@ contains
       type(status_t), intent(inout) :: status
       logical, intent(in), optional :: seed_particles
       real(rp) :: min_mass
+      type(frame_t) :: frame
       logical :: seed
+      integer :: dim, grid_cells(3)
+      real(rp) :: grid_origin(3)
+      type(wall_spec_t), allocatable :: no_walls(:)
 
+      dim = scene%grid%dim
       self%run = scene%run
-      self%gravity = scene%gravity
       self%musl = scene%run%update_scheme == 'MUSL'
-      call self%domain%init(comm, scene%grid%dim, scene%grid%ncells, status)
+      call place_grid(scene%grid, frame, grid_origin, grid_cells)
+      self%gravity = 0.0_rp
+      self%gravity(1:dim) = frame%grid_vector(scene%gravity(1:dim))
+      call self%domain%init(comm, dim, grid_cells, status)
       if (.not. status%ok) return
-      call self%grid%init(self%domain, scene%grid%origin, scene%grid%cell_size)
+      call self%grid%init(self%domain, grid_origin, scene%grid%cell_size, frame)
       call build_materials(scene%materials, self%materials, status)
       if (status%ok) call build_stabilizers(scene%materials, self%schemes, status)
       call agree_on_status(status, self%domain%comm)
       if (.not. status%ok) return
-      call build_box_walls(scene%grid, self%grid, self%walls)
+      if (allocated(scene%walls)) then
+         call build_walls(scene%walls, scene%grid, self%grid, self%walls)
+      else
+         allocate (no_walls(0))
+         call build_walls(no_walls, scene%grid, self%grid, self%walls)
+      end if
+      call build_inlets(scene, self%grid, body_particle_count(scene), self%inlets, self%walls)
 
       call self%particles%init(scene%grid%dim, size(scene%materials), 1024)
       seed = .true.
@@ -106,11 +123,12 @@ contains
    !> One explicit step of length self%dt; afterwards self%dt holds the next stable step.
    subroutine solver_advance(self)
       class(solver_t), intent(inout), target :: self
-      integer :: m, first, last, arrived
+      integer :: m, first, last, arrived, created, i
       real(rp) :: dt
       type(stage_context_t) :: context
 
       dt = self%dt
+      call set_wall_activity(self%walls, self%time)
       context%domain => self%domain
       context%grid => self%grid
       context%dt = dt
@@ -155,11 +173,15 @@ contains
          call self%schemes(m)%scheme%filter_stress(context, self%particles)
       end do
 
-      call keep_particles_inside(self%walls, self%particles, self%wall_corrections)
+      call keep_particles_inside(self%walls, self%grid, self%particles, self%wall_corrections)
+      created = 0
+      do i = 1, size(self%inlets)
+         created = created + self%inlets(i)%inject(self%time, self%time + dt, self%grid, self%domain, self%particles)
+      end do
       call migrate_particles(self%domain, self%grid, self%particles, self%lost_particles, arrived)
-      ! arrivals are appended at the end: re-sort so materials stay contiguous; otherwise re-sort now and
-      ! then for memory locality (removals keep the grouping of the rest)
-      if (arrived > 0 .or. mod(self%step + 1, int(sort_interval, i8)) == 0) then
+      ! arrivals and new particles are appended at the end: re-sort so materials stay contiguous;
+      ! otherwise re-sort now and then for memory locality (removals keep the grouping of the rest)
+      if (arrived > 0 .or. created > 0 .or. mod(self%step + 1, int(sort_interval, i8)) == 0) then
          call sort_by_material_and_cell(self%grid, self%particles)
       else
          call set_material_ranges(self%particles)
@@ -223,10 +245,12 @@ contains
 
    !> dt = CFL h / (sqrt(dim) max_p (c_p + |v_p|)), limited by the viscous step CFL rho h^2 / (2 dim mu)
    !> (algorithms.md section 5.4), or the fixed dt of &run. Collective (global minimum).
+   !> An inlet that is not closed yet counts as a particle of its fluid at rho0 moving at v0: the step
+   !> must resolve the fluid it is about to create (and an empty tank must not take a huge step).
    real(rp) function solver_stable_time_step(self) result(dt)
       class(solver_t), intent(inout) :: self
       real(rp) :: speed, h
-      integer :: m, first, last
+      integer :: m, first, last, i
       h = self%grid%h
       if (self%run%fixed_dt > 0.0_rp) then
          dt = self%run%fixed_dt
@@ -239,6 +263,14 @@ contains
          last = self%particles%material_last(m)
          if (last >= first) speed = max(speed, self%materials(m)%model%max_signal_speed( &
                                          self%particles%density(first:last), self%particles%v(:, first:last)))
+      end do
+      do i = 1, size(self%inlets)
+         associate (spec => self%inlets(i)%spec)
+            if (self%time >= spec%end_time) cycle
+            speed = max(speed, self%materials(spec%material_index)%model%max_signal_speed( &
+                        [self%inlets(i)%density], reshape(spec%velocity * spec%direction(1:self%grid%dim), &
+                                                          [self%grid%dim, 1])))
+         end associate
       end do
       if (speed > 0.0_rp) dt = self%run%cfl * h / (sqrt(real(self%grid%dim, rp)) * speed)
       dt = min(dt, viscous_time_step(self))

@@ -199,7 +199,7 @@ contains
                                                                    particle_xdmf_attributes(), status)
          if (solver%run%grid_output) call write_grid_xdmf(dir//'/'//grid_xdmf, progress%outputs(1:n), &
                                                           grid_xdmf_attributes(solver), solver%grid%dim, &
-                                                          solver%grid%h, status)
+                                                          solver%grid%h, status, solver%grid%frame%rotated)
       end if
       call broadcast_status(status, solver%domain%comm, 0)
    end subroutine write_xdmf

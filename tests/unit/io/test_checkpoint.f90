@@ -12,7 +12,8 @@ module test_checkpoint
    use run_diagnostics, only: diagnostics_t
    use run_progress, only: run_progress_t
    use xdmf_writer, only: output_entry_t
-   use checkpoint, only: write_checkpoint, read_checkpoint, latest_checkpoint_path
+   use checkpoint, only: write_checkpoint, read_checkpoint, latest_checkpoint_path, checkpoint_format_version
+   use input_text, only: int_text
    use output_directory, only: prepare_output_directory
    use output_layout, only: checkpoint_file
    use file_system, only: path_exists
@@ -223,7 +224,7 @@ contains
       call solver%init(scene, comm, status, seed_particles=.false.)
       call read_checkpoint('future.h5', scene, solver, progress, status)
       call assertTrue(index(status%message, 'checkpoint future.h5 has format version 99; this build of flotsam '// &
-                            'reads version 1') > 0, 'message: '//trim(status%message))
+                            'reads version '//int_text(checkpoint_format_version)) > 0, 'message: '//trim(status%message))
       status = status_t()
       call read_checkpoint('other.h5', scene, solver, progress, status)
       call assertTrue(index(status%message, 'checkpoint other.h5 is not a Flotsam checkpoint') > 0, &

@@ -1,0 +1,115 @@
+#!/usr/bin/python3
+"""Short versions of the paper's scenes (inputs/tank_filling.nml, hydrostatic_tank.nml at 45 degrees,
+floating_block.nml), run from the files themselves with only the end time and output folder changed
+(scripts/scene_variant.py), and checked for: mass conservation, the inflow mass flux rho v0 H (within
+1 %, and layer by layer), no particle behind a wall, unique ids, and a block that stays intact.
+The full reproductions are scripts/paper_figures.py (CTest label validation).
+
+usage: check_scenes.py <flotsam> <mpiexec> <tests/runs/scenes> <scripts folder>"""
+
+import os
+import sys
+
+import h5py
+import numpy as np
+
+from flotsam_run import Checks, Flotsam, main_arguments, read_diagnostics
+
+RHO = 1000.0
+# a particle this close behind a wall counts as on it (the safeguard puts particles exactly on it)
+ON_WALL = 1e-9
+
+
+def final_particles(folder, rows):
+    path = os.path.join(folder, "fields", f"fields_{len(rows) - 1:06d}.h5")
+    with h5py.File(path) as f:
+        return {key: f["particles"][key][:] for key in ("position", "material", "mass", "id")}
+
+
+def run(checks, flotsam, inputs, scene, name, ranks, changes):
+    from scene_variant import write_variant
+    changes.setdefault("run", {})["output_dir"] = f"'{name}'"
+    path = write_variant(os.path.join(inputs, scene), flotsam.path(name + ".nml"), changes)
+    flotsam.remove(name)
+    result = flotsam.run(path, ranks)
+    ok = checks.check(result.returncode == 0, f"{name}: runs on {ranks} ranks", result.stderr[-2000:])
+    return (read_diagnostics(flotsam.path(name)) if ok else None), flotsam.path(name)
+
+
+def check_inside(checks, name, x, left_wall_from, right, floor=0.0):
+    """No particle behind the floor, the right wall, or the left wall above `left_wall_from` (the
+    opening below it is closed or fed, so nothing may be behind it either)."""
+    worst = min((x[:, 1] - floor).min(), (right - x[:, 0]).min(), x[:, 0].min())
+    checks.check(worst >= -ON_WALL, f"{name}: no particle behind a wall", f"deepest {worst:.3e} m")
+
+
+def check_inflow(checks, name, rows, speed, height, spacing, solid_mass=0.0):
+    """Mass = solid + rho Dp H x floor(v0 t / Dp) at every output (layer by layer), and the flux over
+    the run within 1 % of rho v0 H."""
+    worst = 0.0
+    for row in rows:
+        t = float(row["time"])
+        layers = np.floor(speed * t / spacing + 1e-9)
+        expected = solid_mass + RHO * spacing * height * layers
+        worst = max(worst, abs(float(row["total_mass"]) - expected) / max(expected, 1.0))
+    checks.check(worst < 1e-12, f"{name}: injected mass = rho Dp H per layer at every output", f"{worst:.2e}")
+    t_end = float(rows[-1]["time"])
+    flux = (float(rows[-1]["total_mass"]) - solid_mass) / t_end
+    checks.close(flux, RHO * speed * height, 0.01, f"{name}: mean inflow mass flux = rho v0 H within 1 %")
+
+
+def main():
+    flotsam_path, mpiexec, _scenes, rest = main_arguments()
+    scripts = os.path.abspath(rest[0])
+    sys.path.insert(0, scripts)
+    inputs = os.path.join(os.path.dirname(scripts), "inputs")
+    checks = Checks()
+    flotsam = Flotsam(flotsam_path, mpiexec, "output")
+
+    # Fig. 1 scene, standard MPM: 0.4 s of filling (8 layers of Dp = 0.05 m: the flux is exact at 0.4 s)
+    rows, folder = run(checks, flotsam, inputs, "tank_filling.nml", "filling", 2,
+                       {"run": {"end_time": "0.4", "output_interval": "0.02"}})
+    if rows:
+        check_inflow(checks, "filling", rows, 1.0, 1.0, 0.05)
+        state = final_particles(folder, rows)
+        check_inside(checks, "filling", state["position"], 1.0, 3.0)
+        checks.check(len(np.unique(state["id"])) == len(state["id"]), "filling: ids unique")
+
+    # Figs. 3-4 scene on the 45 degree grid, FOAL1: 0.2 s at rest
+    rows, folder = run(checks, flotsam, inputs, "hydrostatic_tank.nml", "tank45", 2,
+                       {"run": {"end_time": "0.2", "output_interval": "0.02"}, "grid": {"rotation": "45.0"}})
+    if rows:
+        mass = [float(r["total_mass"]) for r in rows]
+        checks.close(mass[-1], 3.2 * 3.2 * RHO, 1e-12, "tank45: mass = rho x 3.2 m x 3.2 m, kept")
+        h = [float(r["h_eq"]) for r in rows]
+        checks.check(max(abs(v / 3.2 - 1) for v in h) < 0.005, "tank45: h_eq within 0.5 % of 3.2 m",
+                     f"{min(h)} .. {max(h)}")
+        energy = max(float(r["kinetic_energy"]) for r in rows)
+        # bounded: a tenth of a percent of the water's potential energy rho g H^2 W / 2
+        checks.check(energy < 1e-3 * RHO * 10 * 3.2 ** 3 / 2, "tank45: kinetic energy stays small", f"{energy:.3e} J")
+        state = final_particles(folder, rows)
+        x = state["position"]
+        check_inside(checks, "tank45", x, 0.0, 3.2)
+        checks.check(abs(x[:, 2]).max() == 0.0, "tank45: positions written in the world frame (z = 0)")
+
+    # Fig. 5 scene: 0.5 s of injection with the block falling onto the floor, on 2 ranks
+    rows, folder = run(checks, flotsam, inputs, "floating_block.nml", "block", 2,
+                       {"run": {"end_time": "0.5", "output_interval": "0.05"}})
+    if rows:
+        block_mass = 0.4 * 0.4 * 300.0
+        check_inflow(checks, "block", rows, 1.0, 1.0, 0.1 / 3, solid_mass=block_mass)
+        state = final_particles(folder, rows)
+        x, block = state["position"], state["material"] == 2
+        check_inside(checks, "block", x, 1.0, 3.0)
+        checks.check(len(np.unique(state["id"])) == len(state["id"]), "block: ids unique")
+        checks.close(state["mass"][block].sum(), block_mass, 1e-12, "block: block mass kept")
+        size = x[block, :2].max(axis=0) - x[block, :2].min(axis=0)
+        # intact: the particle cloud keeps the block's size (0.4 m less one spacing between the outer
+        # particles) within a spacing either way
+        checks.check(np.all(np.abs(size - (0.4 - 0.1 / 3)) < 0.1 / 3), "block: stays intact (size kept)", str(size))
+
+    sys.exit(checks.summary())
+
+
+if __name__ == "__main__":
+    main()
