@@ -207,9 +207,9 @@ def figure3(args):
                  "Fig. 3 (our defaults, MUSL with 5 % PIC): every scheme finishes 3 s at 0 and 45 degrees",
                  {k: v["end_time"] for k, v in f3.items()})
     flip = summary["fig3_flip1"]
-    check(flip["C0_45"]["max_speed"] > 5 * max(flip["FOAL1_45"]["max_speed"], flip["NB_45"]["max_speed"]),
-          "Fig. 3 (pure FLIP, the paper's setting): at 45 degrees C0 goes unstable, FOAL1 and NB stay bounded",
-          {k: round(v["max_speed"], 3) for k, v in flip.items() if k.endswith("45")})
+    check(not flip["C0_45"]["finished"] and flip["FOAL1_45"]["finished"] and flip["NB_45"]["finished"],
+          "Fig. 3 (pure FLIP, the paper's setting): at 45 degrees C0 goes unstable (stopped by the blow-up "
+          "check), FOAL1 and NB finish", {k: (v["end_time"], round(v["max_speed"], 3)) for k, v in flip.items()})
 
 
 def figure4(args):

@@ -70,8 +70,16 @@ contains
       call b%free()
    end subroutine test_wall_groups_equal_box_walls
 
+   !> In 2-D (gravity along -y) and in 3-D (gravity along -z, the grid turned about the vertical).
    subroutine test_quarter_turn_grid_is_the_same_tank(comm)
       type(MPI_Comm), intent(in) :: comm
+      call check_quarter_turn(comm, 2)
+      call check_quarter_turn(comm, 3)
+   end subroutine test_quarter_turn_grid_is_the_same_tank
+
+   subroutine check_quarter_turn(comm, dim)
+      type(MPI_Comm), intent(in) :: comm
+      integer, intent(in) :: dim
       type(scene_t) :: aligned, turned
       type(solver_t) :: a, b
       type(status_t) :: status
@@ -79,9 +87,17 @@ contains
       integer :: step
       real(rp) :: pressure_a, pressure_b
 
-      aligned = water_scene(2, 0.2_rp, [1.6_rp, 2.4_rp, 0.0_rp], 2.0e7_rp, 10.0_rp)
-      aligned%grid%wall(2, 2) = wall_none
-      call add_body(aligned, 1, [0.0_rp, 0.0_rp, 0.0_rp], [1.6_rp, 1.2_rp, 0.0_rp], 3, .true., 1.2_rp)
+      real(rp) :: depth
+      if (dim == 2) then
+         aligned = water_scene(2, 0.2_rp, [1.6_rp, 2.4_rp, 0.0_rp], 2.0e7_rp, 10.0_rp)
+         call add_body(aligned, 1, [0.0_rp, 0.0_rp, 0.0_rp], [1.6_rp, 1.2_rp, 0.0_rp], 3, .true., 1.2_rp)
+         depth = 1.2_rp
+      else
+         aligned = water_scene(3, 0.2_rp, [1.6_rp, 1.2_rp, 1.2_rp], 2.0e7_rp, 10.0_rp)
+         call add_body(aligned, 1, [0.0_rp, 0.0_rp, 0.0_rp], [1.6_rp, 1.2_rp, 0.6_rp], 2, .true., 0.6_rp)
+         depth = 0.6_rp
+      end if
+      aligned%grid%wall(2, dim) = wall_none
       aligned%materials(1)%stabilization = 'FOAL1'
       turned = aligned
       turned%grid%rotation = 90.0_rp
@@ -102,13 +118,15 @@ contains
       pressure_a = bottom_pressure(a)
       pressure_b = bottom_pressure(b)
       call assertRelativelyEqual(pressure_a, pressure_b, 1.0e-9_rp, 'largest pressure')
-      call assertRelativelyEqual(pressure_a, 1000.0_rp * 10.0_rp * 1.2_rp, 0.1_rp, 'largest pressure ~ rho g H')
-      call assertTrue(da%kinetic_energy < 1.0e-6_rp * 1000.0_rp * 10.0_rp * 1.2_rp**3 .and. &
-                      db%kinetic_energy < 1.0e-6_rp * 1000.0_rp * 10.0_rp * 1.2_rp**3, 'both tanks stay at rest')
+      ! FOAL1 holds the cell averages: the bottom cells' pressure is rho g (H - h / 2)
+      call assertRelativelyEqual(pressure_a, 1000.0_rp * 10.0_rp * (depth - 0.1_rp), 1.0e-3_rp, &
+                                 'largest pressure = rho g (H - h/2)')
+      call assertTrue(da%kinetic_energy < 1.0e-6_rp * 1000.0_rp * 10.0_rp * depth**3 .and. &
+                      db%kinetic_energy < 1.0e-6_rp * 1000.0_rp * 10.0_rp * depth**3, 'both tanks stay at rest')
       call assertEqual(b%wall_corrections, 0, 'no particle crossed a wall of the turned grid')
       call a%free()
       call b%free()
-   end subroutine test_quarter_turn_grid_is_the_same_tank
+   end subroutine check_quarter_turn
 
    !> Largest particle pressure on any rank.
    real(rp) function bottom_pressure(solver) result(pressure)
@@ -138,8 +156,16 @@ contains
       scene%run%cfl = 0.3_rp
    end function inflow_scene
 
+   !> In 2-D, and in 3-D through an opening 0.5 m (along y) x 0.4 m (along z).
    subroutine test_inflow_mass_flux_and_ids(comm)
       type(MPI_Comm), intent(in) :: comm
+      call check_inflow(comm, 2)
+      call check_inflow(comm, 3)
+   end subroutine test_inflow_mass_flux_and_ids
+
+   subroutine check_inflow(comm, dim)
+      type(MPI_Comm), intent(in) :: comm
+      integer, intent(in) :: dim
       type(scene_t) :: scene
       type(solver_t) :: solver
       type(status_t) :: status
@@ -147,10 +173,24 @@ contains
       real(rp), parameter :: rho = 1000.0_rp, speed = 2.0_rp, height = 0.5_rp, spacing = 0.1_rp / 3
       real(rp) :: expected
       integer(i8), allocatable :: ids(:)
-      integer(i8) :: before
+      integer(i8) :: before, per_layer
       integer :: layers, step
+      real(rp) :: area
 
-      scene = inflow_scene()
+      if (dim == 2) then
+         scene = inflow_scene()
+         area = height
+         per_layer = 15
+      else
+         scene = water_scene(3, 0.1_rp, [3.0_rp, 1.0_rp, 1.0_rp], 2.0e6_rp, 10.0_rp)
+         allocate (scene%inlets(1))
+         scene%inlets(1) = inlet_spec_t(material='water', material_index=1, point=[0.0_rp, 0.0_rp, 0.0_rp], &
+                                        direction=[1.0_rp, 0.0_rp, 0.0_rp], height=0.5_rp, width=0.4_rp, &
+                                        velocity=2.0_rp, start_time=0.0_rp, end_time=0.1_rp, particles_per_cell=3)
+         scene%run%cfl = 0.3_rp
+         area = height * 0.4_rp
+         per_layer = 15 * 12
+      end if
       call solver%init(scene, comm, status)
       call assertTrue(status%ok, 'init: '//trim(status%message))
       diag = solver%diagnostics()
@@ -160,23 +200,23 @@ contains
          call solver%advance()
          diag = solver%diagnostics()
          ! the time step resolves the inflow: at most one layer of 15 particles per step
-         call assertTrue(diag%particles - before <= 15_i8, 'one layer per step at most')
+         call assertTrue(diag%particles - before <= per_layer, 'one layer per step at most')
          ! mass = rho Dp H per layer, one layer each time v0 t passes a multiple of Dp [exact]
          layers = floor(speed * min(solver%time, 0.1_rp) / spacing + 1.0e-9_rp)
-         expected = rho * spacing * height * layers
+         expected = rho * spacing * area * layers
          call assertRelativelyEqual(diag%total_mass, expected, 1.0e-12_rp, 'injected mass = rho Dp H x layers')
          if (solver%time > 0.15_rp) exit
       end do
       ! over the open time, the mean flux is rho v0 H within one layer: 0.2 m of 0.2 m here, exactly 6 layers
-      call assertRelativelyEqual(diag%total_mass, rho * speed * height * 0.1_rp, 1.0e-9_rp, 'total = rho v0 H t_open')
-      call assertEqual(diag%particles, 6_i8 * 15_i8, '6 layers of 15 particles')
-      ! ids: first_id (no bodies: 0) + layer * 15 + index, the same whatever the rank count
+      call assertRelativelyEqual(diag%total_mass, rho * speed * area * 0.1_rp, 1.0e-9_rp, 'total = rho v0 H (W) t_open')
+      call assertEqual(diag%particles, 6_i8 * per_layer, '6 layers')
+      ! ids: first_id (no bodies: 0) + layer * per_layer + index, the same whatever the rank count
       ids = gathered_ids(solver, comm)
-      call assertTrue(all(ids == [(int(step, i8), step=0, 89)]), 'ids 0 .. 89, each once')
+      call assertTrue(all(ids == [(int(step, i8), step=0, int(6 * per_layer) - 1)]), 'ids 0 .. N - 1, each once')
       call assertEqual(solver%lost_particles, 0, 'nothing left the grid')
       call assertTrue(step > 100, 'the open inlet limited the time step ('//int_text(step)//' steps to 0.15 s)')
       call solver%free()
-   end subroutine test_inflow_mass_flux_and_ids
+   end subroutine check_inflow
 
    !> Every rank's particle ids, sorted.
    function gathered_ids(solver, comm) result(ids)
