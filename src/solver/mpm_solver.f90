@@ -76,7 +76,7 @@ contains
       real(rp) :: min_mass
       type(frame_t) :: frame
       logical :: seed
-      integer :: dim, grid_cells(3)
+      integer :: dim, grid_cells(3), i
       real(rp) :: grid_origin(3)
       type(wall_spec_t), allocatable :: no_walls(:)
 
@@ -111,8 +111,12 @@ contains
       if (self%musl) allocate (self%remapped_momentum(self%grid%dim, self%grid%node_count))
 
       ! a node is "empty" below a millionth of a millionth of the lightest particle
+      ! (of the particles the bodies and the inlets make: a scene may start empty and fill through an inlet)
       min_mass = huge(1.0_rp)
       if (self%particles%count > 0) min_mass = minval(self%particles%mass(1:self%particles%count))
+      do i = 1, size(self%inlets)
+         min_mass = min(min_mass, self%inlets(i)%particle_mass)
+      end do
       call MPI_Allreduce(MPI_IN_PLACE, min_mass, 1, MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
       self%mass_tolerance = 1.0e-12_rp * min_mass
       self%time = 0.0_rp

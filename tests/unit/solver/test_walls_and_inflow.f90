@@ -14,7 +14,7 @@ module test_walls_and_inflow
    use mpm_solver, only: solver_t
    use run_diagnostics, only: diagnostics_t
    use test_scenes, only: water_scene, add_body
-   use input_text, only: int_text
+   use input_text, only: int_text, real_text
    implicit none
    private
 
@@ -175,7 +175,7 @@ contains
       integer(i8), allocatable :: ids(:)
       integer(i8) :: before, per_layer
       integer :: layers, step
-      real(rp) :: area
+      real(rp) :: area, front
 
       if (dim == 2) then
          scene = inflow_scene()
@@ -214,6 +214,11 @@ contains
       ids = gathered_ids(solver, comm)
       call assertTrue(all(ids == [(int(step, i8), step=0, int(6 * per_layer) - 1)]), 'ids 0 .. N - 1, each once')
       call assertEqual(solver%lost_particles, 0, 'nothing left the grid')
+      ! the fluid flows away from the opening: its front has passed the 0.2 m injected by the time it closed
+      front = 0.0_rp
+      if (solver%particles%count > 0) front = maxval(solver%particles%x(1, 1:solver%particles%count))
+      call MPI_Allreduce(MPI_IN_PLACE, front, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+      call assertTrue(front > 0.2_rp, 'the stream advances (front at '//real_text(front)//' m)')
       call assertTrue(step > 100, 'the open inlet limited the time step ('//int_text(step)//' steps to 0.15 s)')
       call solver%free()
    end subroutine check_inflow
