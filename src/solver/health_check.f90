@@ -12,6 +12,7 @@ module health_check
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use kinds, only: rp
    use particle_set, only: particle_set_t
+   use world_frame, only: frame_t
    use input_text, only: int_text, real_text
    implicit none
    private
@@ -85,23 +86,29 @@ contains
    end subroutine scan_values
 
    !> The first unhealthy particle (local index; 0 if none) and what is wrong with it, e.g.
-   !> "particle 1234 (material 'water') at x = (0.5, 0.25): velocity y = NaN".
-   subroutine describe_unhealthy_particle(particles, speed_limit, material_names, particle, description)
+   !> "particle 1234 (material 'water') at x = (0.5, 0.25): velocity y = NaN". The position is given in
+   !> the world frame (through `frame`) when it is finite; the quantities in the grid's frame.
+   subroutine describe_unhealthy_particle(particles, frame, speed_limit, material_names, particle, description)
       type(particle_set_t), intent(in) :: particles
+      type(frame_t), intent(in) :: frame
       real(rp), intent(in) :: speed_limit
       character(len=*), intent(in) :: material_names(:)
       integer, intent(out) :: particle
       character(len=:), allocatable, intent(out) :: description
-      character(len=:), allocatable :: problem
+      character(len=:), allocatable :: problem, where
       integer :: p
       description = ''
       do p = 1, particles%count
          call find_problem(particles, p, speed_limit, problem)
          if (len(problem) == 0) cycle
          particle = p
+         if (all(ieee_is_finite(particles%x(:, p)))) then
+            where = vector_text(frame%world_point(particles%x(:, p)))
+         else
+            where = vector_text(particles%x(:, p))
+         end if
          description = 'particle '//int_text(particles%id(p))//" (material '"// &
-                       trim(material_names(particles%material(p)))//"') at x = "//vector_text(particles%x(:, p))// &
-                       ': '//problem
+                       trim(material_names(particles%material(p)))//"') at x = "//where//': '//problem
          return
       end do
       particle = 0

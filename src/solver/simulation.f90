@@ -218,7 +218,7 @@ contains
       do m = 1, size(solver%materials)
          names(m) = solver%materials(m)%model%name
       end do
-      call describe_unhealthy_particle(solver%particles, speed_limit, names, particle, description)
+      call describe_unhealthy_particle(solver%particles, solver%grid%frame, speed_limit, names, particle, description)
       if (particle > 0) call status%fail('the solution blew up at step '//int_text(solver%step)//' (t = '// &
                                          real_text(solver%time)//' s) on rank '//int_text(solver%domain%rank)//': '// &
                                          description)

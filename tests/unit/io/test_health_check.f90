@@ -7,6 +7,7 @@ module test_health_check
    use assertions, only: assertTrue, assertFalse, assertEqual
    use particle_set, only: particle_set_t
    use health_check, only: particles_healthy, describe_unhealthy_particle
+   use world_frame, only: frame_t
    implicit none
    private
 
@@ -35,8 +36,9 @@ contains
       character(len=*), intent(in) :: expected_text
       integer :: particle
       character(len=:), allocatable :: description
+      type(frame_t) :: frame       ! the grid frame is the world frame
       call assertFalse(particles_healthy(particles, limit), 'detected by the fast check')
-      call describe_unhealthy_particle(particles, limit, names, particle, description)
+      call describe_unhealthy_particle(particles, frame, limit, names, particle, description)
       call assertEqual(expected_particle, particle, 'the first bad particle')
       call assertTrue(index(description, expected_text) > 0, 'report "'//description//'" contains "'// &
                       expected_text//'"')
@@ -46,9 +48,10 @@ contains
       type(particle_set_t) :: particles
       integer :: particle
       character(len=:), allocatable :: description
+      type(frame_t) :: frame
       particles = sane_particles()
       call assertTrue(particles_healthy(particles, limit), 'sane state')
-      call describe_unhealthy_particle(particles, limit, names, particle, description)
+      call describe_unhealthy_particle(particles, frame, limit, names, particle, description)
       call assertEqual(0, particle, 'no particle named')
    end subroutine test_sane_state_is_healthy
 
