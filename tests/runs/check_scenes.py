@@ -74,7 +74,8 @@ def main():
         state = final_particles(folder, rows)
         check_inside(checks, "filling", state["position"], 1.0, 3.0)
         front = state["position"][:, 0].max()
-        checks.check(front > 0.4, "filling: the stream advances past the 0.4 m injected", f"front at {front:.3f} m")
+        # pinned at the opening (an empty-node threshold gone wrong) the front stays below 0.1 m
+        checks.check(front > 0.25, "filling: the stream advances (0.4 m injected)", f"front at {front:.3f} m")
         checks.check(len(np.unique(state["id"])) == len(state["id"]), "filling: ids unique")
 
     # Figs. 3-4 scene on the 45 degree grid, FOAL1: 0.2 s at rest
