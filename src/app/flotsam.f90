@@ -1,4 +1,5 @@
-!> Flotsam driver: `mpirun -np N flotsam scene.nml [--overwrite] [--restart <checkpoint>|latest]`.
+!> Flotsam driver: `mpirun -np N flotsam scene.nml [override.nml ...] [--set '<namelist text>' ...]
+!> [--overwrite] [--restart <checkpoint>|latest]`. Overrides apply in command-line order.
 !> The only place that touches MPI_COMM_WORLD and the only place that stops the program.
 !>
 !> Exit codes: 0 done; 2 scene, set-up or checkpoint refused; 3 output folder; 4 failure during the
@@ -9,12 +10,13 @@ program flotsam
    use kinds, only: path_len
    use error_status, only: status_t
    use scene_description, only: scene_t
-   use scene_reader, only: read_scene
+   use scene_reader, only: read_scene, scene_override_t
    use output_directory, only: prepare_output_directory, prepare_restart_directory
    use mpm_solver, only: solver_t
    use run_progress, only: run_progress_t
    use checkpoint, only: read_checkpoint, latest_checkpoint_path
    use status_broadcast, only: broadcast_status
+   use input_text, only: int_text
    use simulation, only: run_simulation
    implicit none
 
@@ -25,15 +27,16 @@ program flotsam
    type(solver_t) :: solver
    type(run_progress_t) :: progress
    character(len=:), allocatable :: scene_path, restart_path
+   type(scene_override_t), allocatable :: overrides(:)
    logical :: overwrite
    integer :: rank, exit_code, stopped_by
 
    call MPI_Init()
    call MPI_Comm_rank(MPI_COMM_WORLD, rank)
-   call parse_command_line(scene_path, overwrite, restart_path, exit_code)
+   call parse_command_line(scene_path, overrides, overwrite, restart_path, exit_code)
    if (exit_code >= 0) call finish(exit_code)
 
-   call read_scene(scene_path, MPI_COMM_WORLD, scene, status)
+   call read_scene(scene_path, MPI_COMM_WORLD, scene, status, overrides)
    if (.not. status%ok) call fail(status, exit_scene)
    if (overwrite) scene%run%overwrite = .true.
 
@@ -65,15 +68,18 @@ program flotsam
 
 contains
 
-   !> Read `flotsam <scene.nml> [--overwrite] [--restart <checkpoint>]`. exit_code >= 0 means: stop now
-   !> with that code.
-   subroutine parse_command_line(path, overwrite, restart, exit_code)
+   !> Read `flotsam <scene.nml> [override.nml ...] [--set <text> ...] [--overwrite] [--restart <checkpoint>]`.
+   !> exit_code >= 0 means: stop now with that code.
+   subroutine parse_command_line(path, overrides, overwrite, restart, exit_code)
       character(len=:), allocatable, intent(out) :: path, restart
+      type(scene_override_t), allocatable, intent(out) :: overrides(:)
       logical, intent(out) :: overwrite
       integer, intent(out) :: exit_code
       character(len=4096) :: arg
-      integer :: i
-      logical :: restart_follows, restart_given
+      integer :: i, length
+      logical :: restart_follows, restart_given, set_follows
+      allocate (overrides(0))
+      set_follows = .false.
       overwrite = .false.
       restart_given = .false.
       exit_code = -1
@@ -81,7 +87,18 @@ contains
       restart = ''
       restart_follows = .false.
       do i = 1, command_argument_count()
-         call get_command_argument(i, arg)
+         call get_command_argument(i, arg, length)
+         if (length > len(arg)) then
+            if (rank == 0) write (error_unit, '(a)') 'flotsam: error: argument '//int_text(i)//' is longer than '// &
+               int_text(len(arg))//' characters'
+            exit_code = exit_scene
+            return
+         end if
+         if (set_follows) then
+            call add_override(overrides, trim(arg), .true.)
+            set_follows = .false.
+            cycle
+         end if
          if (restart_follows) then
             restart = trim(arg)
             restart_follows = .false.
@@ -97,11 +114,17 @@ contains
          case ('--restart')
             restart_follows = .true.
             restart_given = .true.
+         case ('--set')
+            set_follows = .true.
          case default
             if (arg(1:10) == '--restart=') then
                restart = trim(arg(11:))
                restart_given = .true.
-            else if (arg(1:1) == '-' .or. len(path) > 0) then
+            else if (arg(1:6) == '--set=') then
+               call add_override(overrides, trim(arg(7:)), .true.)
+            else if (arg(1:1) /= '-' .and. len(path) > 0) then
+               call add_override(overrides, trim(arg), .false.)    ! an override file
+            else if (arg(1:1) == '-') then
                if (rank == 0) write (error_unit, '(a)') 'flotsam: error: unexpected argument '//trim(arg)
                exit_code = exit_scene
                return
@@ -110,7 +133,10 @@ contains
             end if
          end select
       end do
-      if (restart_given .and. len(restart) == 0) then
+      if (set_follows) then
+         if (rank == 0) write (error_unit, '(a)') "flotsam: error: --set needs namelist text, e.g. --set '&grid rotation = 45 /'"
+         exit_code = exit_scene
+      else if (restart_given .and. len(restart) == 0) then
          if (rank == 0) write (error_unit, '(a)') 'flotsam: error: --restart needs a checkpoint file (or latest)'
          exit_code = exit_scene
       else if (len(path) == 0) then
@@ -122,6 +148,24 @@ contains
          exit_code = exit_scene
       end if
    end subroutine parse_command_line
+
+   !> Append an override (element by element: gfortran's array constructor pads the deferred-length
+   !> component of every element to the longest).
+   subroutine add_override(overrides, source, is_text)
+      type(scene_override_t), allocatable, intent(inout) :: overrides(:)
+      character(len=*), intent(in) :: source
+      logical, intent(in) :: is_text
+      type(scene_override_t), allocatable :: grown(:)
+      integer :: i
+      allocate (grown(size(overrides) + 1))
+      do i = 1, size(overrides)
+         grown(i)%source = overrides(i)%source
+         grown(i)%is_text = overrides(i)%is_text
+      end do
+      grown(size(grown))%source = source
+      grown(size(grown))%is_text = is_text
+      call move_alloc(grown, overrides)
+   end subroutine add_override
 
    !> `--restart latest` names the newest checkpoint of the scene's output folder. Collective.
    subroutine resolve_restart_path(path, status)
@@ -145,8 +189,12 @@ contains
 
    subroutine print_usage(unit)
       integer, intent(in) :: unit
-      write (unit, '(a)') 'usage: mpirun -np N flotsam <scene.nml> [--overwrite] [--restart <checkpoint>]', &
+      write (unit, '(a)') 'usage: mpirun -np N flotsam <scene.nml> [override.nml ...] [--set <text> ...]', &
+         '                                 [--overwrite] [--restart <checkpoint>]', &
          '  <scene.nml>               scene file of Fortran namelists (see docs/input.md)', &
+         '  override.nml              namelist file applied on top of the scene (in order)', &
+         "  --set '<namelist text>'   the same, inline: --set '&grid rotation = 45 /'", &
+         '                            --set "&material name = ''water'', stabilization = ''C0'' /"', &
          '  --overwrite               replace a previous run in the output folder', &
          '  --restart <checkpoint>    continue the run from a checkpoint file of its output folder;', &
          '                            --restart latest takes the newest one (see docs/output.md)', &

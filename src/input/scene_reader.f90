@@ -22,6 +22,16 @@ module scene_reader
 
    public :: read_scene
 
+   !> A layer applied on top of the scene file: another namelist file, or namelist text from the command
+   !> line (`--set '&grid rotation = 45 /'`). Singleton groups change the variables they assign; a
+   !> repeated group changes the entries it selects: `&material name = 'water' ... /` the material named
+   !> water, `&body material = 'water' ... /` (and &inlet) the bodies of water; without the selecting
+   !> variable, every entry of the group. An override changes entries; it does not add them.
+   type, public :: scene_override_t
+      character(len=:), allocatable :: source    !< file path, or namelist text
+      logical :: is_text = .false.
+   end type scene_override_t
+
    !> The rank of `comm` that reads the file.
    integer, parameter :: root = 0
 
@@ -120,18 +130,34 @@ contains
    !> Read the scene file `path`. Collective over `comm`: rank 0 reads and checks the file, then the
    !> status and (if it is ok) the scene are broadcast, so that every rank returns the same status and
    !> the same scene. On failure the scene is the default scene_t on every rank.
-   subroutine read_scene(path, comm, scene, status)
+   !> With `overrides`, each is applied in turn on top of the file, and the whole scene is checked after
+   !> the last (messages then name the file "with" its overrides).
+   subroutine read_scene(path, comm, scene, status, overrides)
       character(len=*), intent(in) :: path
       type(MPI_Comm), intent(in) :: comm
       type(scene_t), intent(out) :: scene
       type(status_t), intent(out) :: status
+      type(scene_override_t), intent(in), optional :: overrides(:)
       type(scene_t) :: empty_scene
-      integer :: rank
+      character(len=:), allocatable :: label
+      integer :: rank, i
 
       call MPI_Comm_rank(comm, rank)
       if (rank == root) then
          call load_scene_file(path, scene, status)
-         if (status%ok) call validate_scene(scene, trim(path), status)
+         label = trim(path)
+         if (present(overrides)) then
+            do i = 1, size(overrides)
+               if (.not. status%ok) exit
+               call apply_override(overrides(i), i, scene, status)
+               if (i == 1) then
+                  label = label//' with '//override_label(overrides(i), i)
+               else
+                  label = label//', '//override_label(overrides(i), i)
+               end if
+            end do
+         end if
+         if (status%ok) call validate_scene(scene, label, status)
          if (status%ok) call resolve_scene(scene)
       end if
       call broadcast_status(status, comm, root)
@@ -141,6 +167,162 @@ contains
          scene = empty_scene
       end if
    end subroutine read_scene
+
+   !> How messages name an override: its file, or `--set <i>`.
+   function override_label(override, i) result(label)
+      type(scene_override_t), intent(in) :: override
+      integer, intent(in) :: i
+      character(len=:), allocatable :: label
+      if (override%is_text) then
+         label = '--set '//int_text(i)
+      else
+         label = override%source
+      end if
+   end function override_label
+
+   !> Apply one override (serial, rank 0): text goes through a scratch file, so both kinds share the
+   !> scan and the reads of the scene file.
+   subroutine apply_override(override, i, scene, status)
+      type(scene_override_t), intent(in) :: override
+      integer, intent(in) :: i
+      type(scene_t), intent(inout) :: scene
+      type(status_t), intent(inout) :: status
+      character(len=512) :: message
+      integer :: unit, ios
+      logical :: exists
+
+      if (override%is_text) then
+         open (newunit=unit, status='scratch', action='readwrite', form='formatted', iostat=ios, iomsg=message)
+         if (ios == 0) write (unit, '(a)', iostat=ios, iomsg=message) override%source
+         if (ios == 0) rewind (unit)
+      else
+         inquire (file=override%source, exist=exists)
+         if (.not. exists) then
+            call status%fail(override%source//': override file not found')
+            return
+         end if
+         open (newunit=unit, file=override%source, status='old', action='read', form='formatted', iostat=ios, &
+               iomsg=message)
+      end if
+      if (ios /= 0) then
+         call status%fail(override_label(override, i)//': cannot read the override: '//trim(message))
+         return
+      end if
+      call read_override(unit, override_label(override, i), scene, status)
+      close (unit)
+   end subroutine apply_override
+
+   !> The groups of an override open on `unit` change the scene in place.
+   subroutine read_override(unit, label, scene, status)
+      integer, intent(in) :: unit
+      character(len=*), intent(in) :: label
+      type(scene_t), intent(inout) :: scene
+      type(status_t), intent(inout) :: status
+      type(namelist_file_t) :: file
+      type(scene_t) :: probe
+      character(len=512) :: message
+      character(len=:), allocatable :: group, text, selector, chosen
+      integer :: g, k, j, ios, selected
+
+      call scan_namelist_file(unit, label, known_groups, file, status)
+      if (.not. status%ok) return
+      call check_group_counts(file, status)
+      if (.not. status%ok) return
+      call read_singleton_groups(unit, file, scene, status)
+      if (.not. status%ok) return
+      allocate (probe%materials(1), probe%bodies(1), probe%walls(1), probe%inlets(1))
+      do g = 1, size(file%groups)
+         group = file%groups(g)%name
+         if (.not. any(repeated_groups == group)) cycle
+         k = count_before(file, g) + 1
+         ! the group again as text, so that it can be read into each entry it selects
+         text = '&'//group
+         do j = 1, size(file%groups(g)%items)
+            text = text//' '//file%groups(g)%items(j)%text()//','
+         end do
+         text = text//' /'
+         message = ''
+         call read_group(group, probe, 1, ios, message, text=text)
+         if (ios /= 0) then
+            call report_read_error(file, group, k, message, status)
+            return
+         end if
+         selector = selecting_variable(group)
+         chosen = ''
+         if (len(selector) > 0) then
+            if (file%groups(g)%assigns(selector)) chosen = selected_value(group, probe)
+         end if
+         selected = 0
+         do j = 1, entry_count(scene, group)
+            if (len(chosen) > 0) then
+               if (selected_value(group, scene, j) /= chosen) cycle
+            end if
+            call read_group(group, scene, j, ios, message, text=text)
+            selected = selected + 1
+         end do
+         if (selected == 0) then
+            if (len(chosen) > 0) then
+               call status%fail(group_context(label, group, k)//': the scene has no &'//group//' with '//selector// &
+                                " = '"//chosen//"' (an override changes entries of the scene, it does not add them)")
+            else
+               call status%fail(group_context(label, group, k)//': the scene has no &'//group// &
+                                ' to change (an override changes entries of the scene, it does not add them)')
+            end if
+            return
+         end if
+      end do
+   end subroutine read_override
+
+   !> The variable that selects the entries of a repeated group an override changes ('' : all).
+   pure function selecting_variable(group) result(name)
+      character(len=*), intent(in) :: group
+      character(len=:), allocatable :: name
+      select case (group)
+      case ('material')
+         name = 'name'
+      case ('body', 'inlet')
+         name = 'material'
+      case default
+         name = ''
+      end select
+   end function selecting_variable
+
+   !> The selecting value of entry k (default 1) of a repeated group.
+   function selected_value(group, scene, k) result(value)
+      character(len=*), intent(in) :: group
+      type(scene_t), intent(in) :: scene
+      integer, intent(in), optional :: k
+      character(len=:), allocatable :: value
+      integer :: i
+      i = 1
+      if (present(k)) i = k
+      select case (group)
+      case ('material')
+         value = trim(scene%materials(i)%name)
+      case ('body')
+         value = trim(scene%bodies(i)%material)
+      case ('inlet')
+         value = trim(scene%inlets(i)%material)
+      case default
+         value = ''
+      end select
+   end function selected_value
+
+   pure integer function entry_count(scene, group) result(n)
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: group
+      n = 0
+      select case (group)
+      case ('material')
+         if (allocated(scene%materials)) n = size(scene%materials)
+      case ('body')
+         if (allocated(scene%bodies)) n = size(scene%bodies)
+      case ('wall')
+         if (allocated(scene%walls)) n = size(scene%walls)
+      case ('inlet')
+         if (allocated(scene%inlets)) n = size(scene%inlets)
+      end select
+   end function entry_count
 
    !> Serial part of `read_scene`: open `path` and read every group into `scene`.
    subroutine load_scene_file(path, scene, status)
