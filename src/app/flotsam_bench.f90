@@ -24,6 +24,7 @@ program flotsam_bench
    use checkpoint, only: write_checkpoint
    use health_check, only: particles_healthy
    use simulation, only: blow_up_speed
+   use process_memory, only: resident_bytes
    implicit none
 
    type(scene_t) :: scene
@@ -53,7 +54,7 @@ program flotsam_bench
    read (arg, *) steps
    scene%run%progress_interval = 0.0_rp
 
-   rss_before = resident_bytes()
+   rss_before = real(resident_bytes(), rp)
    call solver%init(scene, MPI_COMM_WORLD, status)
    if (.not. status%ok) then
       if (rank == 0) write (error_unit, '(a)') 'flotsam_bench: error: '//trim(status%message)
@@ -71,7 +72,7 @@ program flotsam_bench
    end do
    call MPI_Barrier(MPI_COMM_WORLD)
    t1 = MPI_Wtime()
-   rss_after = resident_bytes()
+   rss_after = real(resident_bytes(), rp)
    diag = solver%diagnostics()
    if (rank == 0) write (output_unit, '(i0,1x,i0,1x,i0,1x,i0,1x,es12.5,1x,es12.5,1x,f10.1)') scene%grid%dim, n_ranks, &
       diag%particles, steps, t1 - t0, real(diag%particles, rp) * steps / ((t1 - t0) * n_ranks), &
@@ -125,23 +126,4 @@ contains
       call MPI_Finalize()
       error stop 2
    end subroutine bench_failure
-
-   !> Resident set size of this process [bytes], from /proc/self/status (0 where unavailable).
-   real(rp) function resident_bytes()
-      integer :: unit, ios
-      character(len=256) :: line
-      integer(i8) :: kib
-      resident_bytes = 0.0_rp
-      open (newunit=unit, file='/proc/self/status', action='read', iostat=ios)
-      if (ios /= 0) return
-      do
-         read (unit, '(a)', iostat=ios) line
-         if (ios /= 0) exit
-         if (line(1:6) == 'VmRSS:') then
-            read (line(7:), *) kib
-            resident_bytes = 1024.0_rp * real(kib, rp)
-         end if
-      end do
-      close (unit)
-   end function resident_bytes
 end program flotsam_bench

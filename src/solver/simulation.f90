@@ -13,6 +13,7 @@ module simulation
    use mpm_solver, only: solver_t
    use run_diagnostics, only: diagnostics_t, diagnostics_header, diagnostics_row
    use csv_writer, only: csv_writer_t, keep_rows_until
+   use run_summary, only: write_run_summary
    use progress_reporter, only: progress_reporter_t
    use status_broadcast, only: broadcast_status, agree_on_status
    use health_check, only: particles_healthy, describe_unhealthy_particle
@@ -52,8 +53,9 @@ contains
       character(len=:), allocatable :: dir, checkpoint_path
       real(rp) :: end_time, interval, speed_limit, last_checkpoint_wall
       integer :: flags(3)
-      integer(i8) :: last_checkpoint_step
+      integer(i8) :: last_checkpoint_step, first_step, particle_steps
       logical :: at_output, checkpoint_due
+      character(len=:), allocatable :: outcome
 
       stopped_by = 0
       dir = trim(solver%run%output_dir)
@@ -80,11 +82,15 @@ contains
       call reporter%start(solver%run%progress_interval, solver%time, end_time)
       last_checkpoint_wall = reporter%elapsed()
       last_checkpoint_step = solver%step
+      first_step = solver%step
+      particle_steps = 0
+      outcome = 'finished'
 
       do while (solver%time < end_time * (1.0_rp - 1.0e-12_rp) .and. solver%step < solver%run%max_steps)
          ! land exactly on the next output time
          if (solver%time + solver%dt * (1.0_rp + 1.0e-9_rp) >= progress%next_output_time) &
             solver%dt = progress%next_output_time - solver%time
+         particle_steps = particle_steps + solver%particles%count
          call solver%advance()
          call reporter%update(solver%time, solver%step, diag%particles, solver%domain%rank == 0)
 
@@ -99,6 +105,7 @@ contains
 
          if (flags(flag_unhealthy) > 0) then
             call report_blow_up(solver, progress, speed_limit, status)
+            outcome = 'blew_up'
             exit
          end if
 
@@ -123,6 +130,7 @@ contains
          end if
          if (flags(flag_signal) > 0) then
             stopped_by = flags(flag_signal)
+            outcome = 'stopped_by_signal'
             call status%fail('stopped by '//signal_name(stopped_by)//' at step '//int_text(solver%step)//' (t = '// &
                              real_text(solver%time)//' s); checkpoint written: '//checkpoint_path// &
                              '; continue with --restart '//checkpoint_path)
@@ -134,6 +142,13 @@ contains
       if (status%ok .and. last_checkpoint_step /= solver%step) &
          call write_checkpoint(solver, progress, dir, solver%run%checkpoints_kept, checkpoint_path, status)
       call csv%close()
+      if (.not. status%ok .and. outcome == 'finished') outcome = 'failed'
+      block
+         type(status_t) :: summary_status     ! a summary that cannot be written must not hide the run's own status
+         call write_run_summary(dir, solver%domain%comm, reporter%elapsed(), solver%step - first_step, &
+                                particle_steps, outcome, summary_status)
+         if (status%ok .and. .not. summary_status%ok) status = summary_status
+      end block
    end subroutine run_simulation
 
    !> The particle speed taken as a blow-up [m/s]: &run speed_limit, or by default 10 times the fastest
