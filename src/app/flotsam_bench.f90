@@ -62,13 +62,14 @@ program flotsam_bench
       error stop 2
    end if
    warm_up = max(1, steps / 20)
+   call solver%balance_load(status)
    do step = 1, warm_up
-      call solver%advance()
+      call advance()
    end do
    call MPI_Barrier(MPI_COMM_WORLD)
    t0 = MPI_Wtime()
    do step = 1, steps
-      call solver%advance()
+      call advance()
    end do
    call MPI_Barrier(MPI_COMM_WORLD)
    t1 = MPI_Wtime()
@@ -82,6 +83,13 @@ program flotsam_bench
    call MPI_Finalize()
 
 contains
+
+   !> A step and, as in the time loop, the balance check every rebalance_interval steps.
+   subroutine advance()
+      call solver%advance()
+      if (mod(solver%step, int(scene%run%rebalance_interval, i8)) == 0) call solver%balance_load(status)
+      if (.not. status%ok) call bench_failure()
+   end subroutine advance
 
    !> Time the output of the current state: fields file, checkpoint, health check (see the header).
    subroutine time_output(step_seconds)

@@ -34,6 +34,9 @@ module scene_description
       real(rp) :: checkpoint_interval_wall = 3600.0_rp  !< wall seconds between checkpoints; 0: not by time
       integer :: checkpoints_kept = 2         !< newest checkpoints kept on disk
       real(rp) :: speed_limit = 0.0_rp        !< particle speed taken as a blow-up [m/s]; 0: 10 x fastest wave
+      !> rebalance when the largest rank holds more than this multiple of the mean particles per rank; 0: never
+      real(rp) :: rebalance_threshold = 1.1_rp
+      integer :: rebalance_interval = 20      !< steps between balance checks (also at every output time)
    end type run_control_t
 
    !> `&grid` and `&box_walls`: the scene box (world frame), the grid that covers it, and the box's walls.

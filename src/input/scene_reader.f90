@@ -71,6 +71,8 @@ module scene_reader
       variable_info_t('run', 'checkpoint_interval_wall', 'real', .false.), &
       variable_info_t('run', 'checkpoints_kept', 'integer', .false.), &
       variable_info_t('run', 'speed_limit', 'real', .false.), &
+      variable_info_t('run', 'rebalance_threshold', 'real', .false.), &
+      variable_info_t('run', 'rebalance_interval', 'integer', .false.), &
       variable_info_t('grid', 'dim', 'integer', .false.), &
       variable_info_t('grid', 'cell_size', 'real', .true.), &
       variable_info_t('grid', 'origin', 'real3', .false.), &
@@ -708,14 +710,14 @@ contains
       integer, intent(in), optional :: unit
       character(len=*), intent(in), optional :: text
       real(rp) :: end_time, cfl, dt, output_interval, flip_fraction, theta, progress_interval, floor_size, &
-                  checkpoint_interval_wall, speed_limit
+                  checkpoint_interval_wall, speed_limit, rebalance_threshold
       character(len=text_len) :: output_dir, update_scheme
       logical :: overwrite, particle_output, grid_output
       integer(i8) :: max_steps, checkpoint_interval_steps
-      integer :: checkpoints_kept
+      integer :: checkpoints_kept, rebalance_interval
       namelist /run/ end_time, cfl, dt, output_interval, output_dir, overwrite, update_scheme, flip_fraction, &
          theta, max_steps, progress_interval, floor_size, particle_output, grid_output, checkpoint_interval_steps, &
-         checkpoint_interval_wall, checkpoints_kept, speed_limit
+         checkpoint_interval_wall, checkpoints_kept, speed_limit, rebalance_threshold, rebalance_interval
 
       end_time = control%end_time
       cfl = control%cfl
@@ -735,6 +737,8 @@ contains
       checkpoint_interval_wall = control%checkpoint_interval_wall
       checkpoints_kept = control%checkpoints_kept
       speed_limit = control%speed_limit
+      rebalance_threshold = control%rebalance_threshold
+      rebalance_interval = control%rebalance_interval
       if (present(text)) then
          read (text, nml=run, iostat=ios, iomsg=message)
       else
@@ -761,6 +765,8 @@ contains
       control%checkpoint_interval_wall = checkpoint_interval_wall
       control%checkpoints_kept = checkpoints_kept
       control%speed_limit = speed_limit
+      control%rebalance_threshold = rebalance_threshold
+      control%rebalance_interval = rebalance_interval
    end subroutine read_run_group
 
    subroutine read_grid_group(spec, ios, message, unit, text)

@@ -181,6 +181,17 @@ contains
          call status%fail(where//': variable checkpoints_kept must be >= 1, got '//int_text(run%checkpoints_kept))
       end if
       call check_real(where, 'speed_limit', run%speed_limit, status, at_least=0.0_rp)
+      ! below 1 even a perfect balance would exceed the threshold (NaN fails the finiteness test first)
+      if (.not. ieee_is_finite(run%rebalance_threshold)) then
+         call check_real(where, 'rebalance_threshold', run%rebalance_threshold, status)
+      else if (run%rebalance_threshold < 0.0_rp .or. &
+               (run%rebalance_threshold > 0.0_rp .and. run%rebalance_threshold < 1.0_rp)) then
+         call status%fail(where//': variable rebalance_threshold must be 0 (off) or >= 1, got '// &
+                          real_text(run%rebalance_threshold))
+      end if
+      if (run%rebalance_interval < 1) then
+         call status%fail(where//': variable rebalance_interval must be >= 1, got '//int_text(run%rebalance_interval))
+      end if
    end subroutine validate_run
 
    subroutine validate_grid(grid, path, status)

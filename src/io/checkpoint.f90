@@ -5,9 +5,10 @@
 !> each rank's order, the rank each slab came from, time, step, the next dt, the per-rank counters
 !> (lost particles, wall corrections), the empty-node mass tolerance, and the run's progress (next
 !> output time, the outputs written so far, the checkpoint number) and the decomposition (rank count
-!> and slab boundaries). Restarting on the same decomposition restores every rank's particles in their
-!> order, so the continued run is bitwise identical to an uninterrupted one; on another one the
-!> particles are redistributed by position and re-sorted (equal to round-off).
+!> and slab boundaries, which load balancing may have moved). Restarting on the same number of ranks
+!> adopts the written decomposition and restores every rank's particles in their order, so the
+!> continued run is bitwise identical to an uninterrupted one; on another number the particles are
+!> redistributed by position over the uniform decomposition and re-sorted (equal to round-off).
 !>
 !> A checkpoint is written as `<name>.tmp`, synced to disk, and renamed only when complete; it carries
 !> a format name and version, and an attribute `complete` written last. Reading checks all of these
@@ -19,6 +20,7 @@ module checkpoint
    use error_status, only: status_t
    use scene_description, only: scene_t
    use mpm_solver, only: solver_t
+   use domain_decomposition, only: valid_layout
    use world_frame, only: frame_t, place_grid
    use particle_sorting, only: update_cells, sort_by_material_and_cell
    use particle_redistribution, only: redistribute_particles
@@ -34,7 +36,8 @@ module checkpoint
 
    !> Identification of the file format; a reader accepts exactly this version.
    character(len=*), parameter, public :: checkpoint_format = 'flotsam checkpoint'
-   integer, parameter, public :: checkpoint_format_version = 2   ! 2: grid rotation
+   !> 2: grid rotation; 3: cuts sized (ranks + 1) x 3 for any rank grid (load balancing)
+   integer, parameter, public :: checkpoint_format_version = 3
 
    public :: write_checkpoint, read_checkpoint, latest_checkpoint_path
 
@@ -280,12 +283,16 @@ contains
          call file%close(status)
          return
       end if
-      ! the same decomposition: the same number of ranks and the same slab boundaries (cuts)
+      ! the same number of ranks: continue in the writer's decomposition (rebalanced or not), each rank
+      ! with the slab it wrote (ranks keep their numbers in any rank grid)
       same_decomposition = ranks_written == n_ranks
       if (same_decomposition) then
          allocate (cuts(size(solver%domain%cuts)))
          call file%read_attribute('cuts', cuts, status)
-         same_decomposition = all(cuts == reshape(solver%domain%cuts, [size(cuts)]))
+         if (status%ok) then
+            if (.not. valid_layout(reshape(cuts, shape(solver%domain%cuts)), solver%domain%global_cells, &
+                                   solver%domain%dim, n_ranks)) call status%fail(where//' has an invalid decomposition')
+         end if
       end if
       if (same_decomposition) then
          slab = slab_t(sum(rank_counts(1:rank)), rank_counts(rank + 1), total)
@@ -312,6 +319,10 @@ contains
       if (.not. status%ok) return
 
       ! accepted: adopt the state
+      if (same_decomposition) then
+         call solver%set_layout(reshape(cuts, shape(solver%domain%cuts)), status)
+         if (.not. status%ok) return
+      end if
       call solver%particles%init(scene%grid%dim, size(scene%materials), max(n, 1024))
       do p = 1, n
          call solver%particles%add(x(:, p), v(:, p), mass(p), density(p), sbar(:, p), material(p), id(p))

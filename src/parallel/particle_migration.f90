@@ -51,7 +51,9 @@ contains
                   if (kept /= p) call particles%copy_particle(p, kept)
                else
                   n_outside = n_outside - 1
-                  if (domain%neighbour(side, k) == MPI_PROC_NULL) then
+                  ! off the grid: lost here, also when a neighbour's box lies between (the neighbour
+                  ! would find it outside its box and keep it, with no cell)
+                  if (domain%neighbour(side, k) == MPI_PROC_NULL .or. c < 0 .or. c >= grid%global_cells(k)) then
                      lost = lost + 1
                   else
                      n_out(side) = n_out(side) + 1

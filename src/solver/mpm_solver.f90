@@ -10,10 +10,13 @@
 !> Everything runs in the grid's frame; the scene (world frame) is mapped into it once, in init.
 module mpm_solver
    use kinds, only: rp, i8
-   use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_MIN
+   use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_Allgather, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_MIN, &
+                      MPI_INTEGER8
    use error_status, only: status_t
    use scene_description, only: scene_t, run_control_t, wall_spec_t
    use domain_decomposition, only: domain_t
+   use load_balance, only: balanced_layout
+   use particle_redistribution, only: redistribute_particles
    use background_grid, only: grid_t, row_mass
    use node_halo, only: sum_shared_nodes
    use particle_set, only: particle_set_t
@@ -38,6 +41,7 @@ module mpm_solver
    integer, parameter :: sort_interval = 20
 
    type, public :: solver_t
+      type(scene_t) :: scene                    !< what the walls and inlets are rebuilt from
       type(run_control_t) :: run
       real(rp) :: gravity(3) = 0.0_rp           !< grid frame
       type(domain_t) :: domain
@@ -59,6 +63,8 @@ module mpm_solver
       procedure :: advance => solver_advance
       procedure :: stable_time_step => solver_stable_time_step
       procedure :: diagnostics => solver_diagnostics
+      procedure :: balance_load => solver_balance_load
+      procedure :: set_layout => solver_set_layout
       procedure :: free => solver_free
    end type solver_t
 
@@ -78,9 +84,9 @@ contains
       logical :: seed
       integer :: dim, grid_cells(3), i
       real(rp) :: grid_origin(3)
-      type(wall_spec_t), allocatable :: no_walls(:)
 
       dim = scene%grid%dim
+      self%scene = scene
       self%run = scene%run
       self%musl = scene%run%update_scheme == 'MUSL'
       call place_grid(scene%grid, frame, grid_origin, grid_cells)
@@ -93,13 +99,7 @@ contains
       if (status%ok) call build_stabilizers(scene%materials, self%schemes, status)
       call agree_on_status(status, self%domain%comm)
       if (.not. status%ok) return
-      if (allocated(scene%walls)) then
-         call build_walls(scene%walls, scene%grid, self%grid, self%walls)
-      else
-         allocate (no_walls(0))
-         call build_walls(no_walls, scene%grid, self%grid, self%walls)
-      end if
-      call build_inlets(scene, self%grid, body_particle_count(scene), self%inlets, self%walls)
+      call build_boundaries(self)
 
       call self%particles%init(scene%grid%dim, size(scene%materials), 1024)
       seed = .true.
@@ -107,8 +107,7 @@ contains
       if (seed) call seed_bodies(scene, self%grid, self%domain, self%particles)
       call update_cells(self%grid, self%particles)
       call sort_by_material_and_cell(self%grid, self%particles)
-      if (allocated(self%remapped_momentum)) deallocate (self%remapped_momentum)
-      if (self%musl) allocate (self%remapped_momentum(self%grid%dim, self%grid%node_count))
+      call size_node_arrays(self)
 
       ! a node is "empty" below a millionth of a millionth of the lightest particle
       ! (of the particles the bodies and the inlets make: a scene may start empty and fill through an inlet)
@@ -123,6 +122,59 @@ contains
       self%step = 0
       self%dt = self%stable_time_step()
    end subroutine solver_init
+
+   !> The walls (with their local nodes) and the inlets (with their feeder walls) of the scene.
+   subroutine build_boundaries(self)
+      type(solver_t), intent(inout) :: self
+      type(wall_spec_t), allocatable :: no_walls(:)
+      if (allocated(self%scene%walls)) then
+         call build_walls(self%scene%walls, self%scene%grid, self%grid, self%walls)
+      else
+         allocate (no_walls(0))
+         call build_walls(no_walls, self%scene%grid, self%grid, self%walls)
+      end if
+      call build_inlets(self%scene, self%grid, body_particle_count(self%scene), self%inlets, self%walls)
+   end subroutine build_boundaries
+
+   !> Solver arrays over the local nodes (the grid's own arrays are sized by grid%init).
+   subroutine size_node_arrays(self)
+      type(solver_t), intent(inout) :: self
+      if (allocated(self%remapped_momentum)) deallocate (self%remapped_momentum)
+      if (self%musl) allocate (self%remapped_momentum(self%grid%dim, self%grid%node_count))
+   end subroutine size_node_arrays
+
+   !> Rebalance if the largest rank holds more than rebalance_threshold times the mean number of
+   !> particles per rank and another layout lowers that largest count (docs/theory.md section 6).
+   !> Between steps only. Collective: one gather of the counts; the layout search only when unbalanced.
+   subroutine solver_balance_load(self, status)
+      class(solver_t), intent(inout) :: self
+      type(status_t), intent(inout) :: status
+      integer(i8) :: counts(self%domain%nranks), largest
+      integer :: cuts(0:self%domain%nranks, 3)
+      if (self%domain%nranks == 1 .or. self%run%rebalance_threshold <= 0.0_rp) return
+      call MPI_Allgather(int(self%particles%count, i8), 1, MPI_INTEGER8, counts, 1, MPI_INTEGER8, self%domain%comm)
+      if (real(maxval(counts), rp) * self%domain%nranks <= self%run%rebalance_threshold * real(sum(counts), rp)) return
+      call balanced_layout(self%domain, self%grid, self%particles, cuts, largest)
+      ! no better layout (particles packed in fewer layers than the ranks need): keep this one
+      if (largest < maxval(counts)) call self%set_layout(cuts, status)
+   end subroutine solver_balance_load
+
+   !> Adopt the decomposition `cuts` (as domain%cuts; the rank grid may change): the particles go to
+   !> their new owners, the grid, the walls' node lists and the node arrays are made for the new box.
+   !> The stabilizers size their cell arrays to the grid when they next run. Collective.
+   subroutine solver_set_layout(self, cuts, status)
+      class(solver_t), intent(inout) :: self
+      integer, intent(in) :: cuts(0:, :)
+      type(status_t), intent(inout) :: status
+      call self%domain%set_layout(cuts)
+      call redistribute_particles(self%domain, self%grid, self%particles, status)
+      if (.not. status%ok) return
+      call self%grid%init(self%domain, self%grid%origin, self%grid%h, self%grid%frame)
+      call build_boundaries(self)
+      call update_cells(self%grid, self%particles)
+      call sort_by_material_and_cell(self%grid, self%particles)
+      call size_node_arrays(self)
+   end subroutine solver_set_layout
 
    !> One explicit step of length self%dt; afterwards self%dt holds the next stable step.
    subroutine solver_advance(self)

@@ -17,6 +17,7 @@ module run_diagnostics
       real(rp) :: max_speed = 0.0_rp
       integer(i8) :: lost_particles = 0     !< particles that left the grid (open sides)
       integer(i8) :: wall_corrections = 0   !< particles put back behind a wall (cumulative)
+      real(rp) :: max_rank_share = 0.0_rp   !< largest fraction of the particles on one rank (0: none)
    end type diagnostics_t
 
    public :: compute_diagnostics, diagnostics_header, diagnostics_row
@@ -32,7 +33,7 @@ contains
       integer(i8), intent(in) :: lost, corrections
       type(diagnostics_t), intent(inout) :: diag
       real(rp) :: sums(3), speed2
-      integer(i8) :: counts(3)
+      integer(i8) :: counts(3), largest
       integer :: p, m
       sums = 0.0_rp
       speed2 = 0.0_rp
@@ -48,6 +49,7 @@ contains
       call MPI_Allreduce(MPI_IN_PLACE, sums, 3, MPI_DOUBLE_PRECISION, MPI_SUM, comm)
       call MPI_Allreduce(MPI_IN_PLACE, speed2, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
       call MPI_Allreduce(MPI_IN_PLACE, counts, 3, MPI_INTEGER8, MPI_SUM, comm)
+      call MPI_Allreduce(int(particles%count, i8), largest, 1, MPI_INTEGER8, MPI_MAX, comm)
       diag%total_mass = sums(1)
       diag%kinetic_energy = sums(2)
       diag%fluid_volume = sums(3)
@@ -56,12 +58,14 @@ contains
       diag%particles = counts(1)
       diag%lost_particles = counts(2)
       diag%wall_corrections = counts(3)
+      diag%max_rank_share = 0.0_rp
+      if (counts(1) > 0) diag%max_rank_share = real(largest, rp) / real(counts(1), rp)
    end subroutine compute_diagnostics
 
    pure function diagnostics_header() result(line)
       character(len=:), allocatable :: line
       line = 'time,step,dt,particles,total_mass,kinetic_energy,fluid_volume,h_eq,max_speed,' // &
-             'lost_particles,wall_corrections'
+             'lost_particles,wall_corrections,max_rank_share'
    end function diagnostics_header
 
    !> One CSV row; reals in full precision (g0) so rows can be compared to round-off.
@@ -69,9 +73,10 @@ contains
       type(diagnostics_t), intent(in) :: diag
       character(len=:), allocatable :: line
       character(len=512) :: buffer
-      write (buffer, '(g0,",",i0,",",g0,",",i0,5(",",g0),2(",",i0))') &
+      write (buffer, '(g0,",",i0,",",g0,",",i0,5(",",g0),2(",",i0),",",g0)') &
          diag%time, diag%step, diag%dt, diag%particles, diag%total_mass, diag%kinetic_energy, &
-         diag%fluid_volume, diag%h_eq, diag%max_speed, diag%lost_particles, diag%wall_corrections
+         diag%fluid_volume, diag%h_eq, diag%max_speed, diag%lost_particles, diag%wall_corrections, &
+         diag%max_rank_share
       line = trim(adjustl(buffer))
    end function diagnostics_row
 end module run_diagnostics

@@ -3,6 +3,9 @@
 !> wall time, at the end and on SIGTERM/SIGINT; a stop within the step in which the solution stops
 !> being finite or blows up (docs/output.md).
 !>
+!> Every rebalance_interval steps and at every output time the decomposition is rebalanced by particle
+!> count if it has drifted (solver%balance_load).
+!>
 !> After every step the ranks agree, in one small reduction, on three flags: an unhealthy particle
 !> somewhere, a termination signal received somewhere, and (rank 0's clock) a wall-time checkpoint
 !> being due. All ranks therefore take the same branch in the same step.
@@ -65,6 +68,12 @@ contains
       call open_diagnostics(solver, progress, csv, status)
       if (.not. status%ok) return
 
+      ! a restart continues in the checkpoint's layout (read_checkpoint); a new run starts balanced
+      if (.not. progress%restarted) call solver%balance_load(status)
+      if (.not. status%ok) then
+         call csv%close()
+         return
+      end if
       diag = solver%diagnostics()
       if (progress%restarted) then
          call write_xdmf(solver, progress, status)
@@ -111,6 +120,11 @@ contains
 
          at_output = solver%time >= progress%next_output_time * (1.0_rp - 1.0e-12_rp) .or. &
                      solver%step >= solver%run%max_steps
+         ! between steps, and before an output so that its shares are balanced ones
+         if (at_output .or. mod(solver%step, int(solver%run%rebalance_interval, i8)) == 0) then
+            call solver%balance_load(status)
+            if (.not. status%ok) exit
+         end if
          if (at_output) then
             diag = solver%diagnostics()
             if (solver%domain%rank == 0) call csv%write_row(diagnostics_row(diag))

@@ -3,8 +3,10 @@
 against the run's own diagnostics.csv: one fields file per diagnostics row at the same time and step,
 particle counts, total mass, kinetic energy, fluid volume and maximum speed recomputed from the
 particle fields, unique ids, positions in the world frame, consistent stress fields, a grid whose nodal
-mass sums to the total mass, and the XDMF files listing every output time. The 2-D scene runs on 3 ranks
-of which one holds no particle; the 3-D scene on 2 ranks. Also runs scripts/plot_diagnostics.py.
+mass sums to the total mass, the largest rank's share (max_rank_share) from the particles' ranks, and
+the XDMF files listing every output time. The 2-D scene runs on 3 ranks of which one holds no particle
+(load balancing off); the 3-D scene on 2 ranks, balanced: no rank holds more than 60 % of the
+particles at any output. Also runs scripts/plot_diagnostics.py.
 
 usage: check_output.py <flotsam> <mpiexec> <tests/runs/scenes> <scripts folder>"""
 
@@ -57,6 +59,12 @@ def check_run(checks, flotsam, scenes, name, ranks, fluid_materials, empty_rank=
             checks.check(np.allclose(volume, mass / density, rtol=1e-14), f"{label}: volume = mass / density")
             checks.check(np.array_equal(np.sort(ids), np.arange(n)), f"{label}: ids unique, 0 .. N-1")
             checks.check(np.array_equal(p["connectivity"][:], np.arange(n)), f"{label}: connectivity 0 .. N-1")
+            if n > 0:
+                checks.close(np.bincount(rank).max() / n, float(row["max_rank_share"]), 1e-15,
+                             f"{label}: max_rank_share = largest count in /particles/rank / N")
+            if ranks == 2 and empty_rank is None:     # load balancing on (the default)
+                checks.check(float(row["max_rank_share"]) <= 0.6, f"{label}: no rank holds more than 60 %",
+                             row["max_rank_share"])
             if empty_rank is not None:
                 checks.check(empty_rank not in rank and set(rank) <= set(range(ranks)),
                              f"{label}: rank {empty_rank} held no particle and still wrote", f"{set(rank)}")

@@ -1,11 +1,12 @@
 !> Scenes built in code for the tests: the same values a scene file would give, without a file.
 module test_scenes
    use kinds, only: rp
-   use scene_description, only: scene_t, body_spec_t, wall_slip, model_newtonian_fluid
+   use scene_description, only: scene_t, body_spec_t, wall_spec_t, inlet_spec_t, wall_none, wall_slip, &
+                                model_newtonian_fluid
    implicit none
    private
 
-   public :: water_scene, add_body
+   public :: water_scene, add_body, tank_with_inlet
 
 contains
 
@@ -54,4 +55,22 @@ contains
       body%free_surface_level = surface
       scene%bodies = [scene%bodies, body]
    end subroutine add_body
+
+   !> A 2-D tank 3 m x 2 m (cell 0.1 m, K = 2 MPa, g = 10) with a floor and a right wall, filled through
+   !> an opening of `height` at the foot of the left wall (a slip wall above it): water enters at
+   !> `velocity` from t = 0 to `end_time`, 3 particles per cell.
+   function tank_with_inlet(height, velocity, end_time) result(scene)
+      real(rp), intent(in) :: height, velocity, end_time
+      type(scene_t) :: scene
+      scene = water_scene(2, 0.1_rp, [3.0_rp, 2.0_rp, 0.0_rp], 2.0e6_rp, 10.0_rp)
+      scene%grid%wall = wall_none
+      scene%grid%wall(1, 2) = wall_slip
+      scene%grid%wall(2, 1) = wall_slip
+      allocate (scene%walls(1), scene%inlets(1))
+      scene%walls(1) = wall_spec_t(point=[0.0_rp, height, 0.0_rp], normal=[1.0_rp, 0.0_rp, 0.0_rp], &
+                                   lower=[0.0_rp, height, 0.0_rp], upper=[0.0_rp, 2.0_rp, 0.0_rp])
+      scene%inlets(1) = inlet_spec_t(material='water', material_index=1, point=[0.0_rp, 0.0_rp, 0.0_rp], &
+                                     direction=[1.0_rp, 0.0_rp, 0.0_rp], height=height, velocity=velocity, &
+                                     start_time=0.0_rp, end_time=end_time, particles_per_cell=3)
+   end function tank_with_inlet
 end module test_scenes

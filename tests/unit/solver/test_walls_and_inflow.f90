@@ -10,10 +10,10 @@ module test_walls_and_inflow
                       MPI_INTEGER8, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_MIN, MPI_Comm_size
    use assertions, only: assertTrue, assertEqual, assertRelativelyEqual
    use error_status, only: status_t
-   use scene_description, only: scene_t, wall_spec_t, inlet_spec_t, wall_none, wall_slip
+   use scene_description, only: scene_t, wall_spec_t, inlet_spec_t, wall_none
    use mpm_solver, only: solver_t
    use run_diagnostics, only: diagnostics_t
-   use test_scenes, only: water_scene, add_body
+   use test_scenes, only: water_scene, add_body, tank_with_inlet
    use input_text, only: int_text, real_text
    implicit none
    private
@@ -143,16 +143,7 @@ contains
    !> 0.5 m at the floor through which water enters at 2 m/s until t = 0.1 s.
    function inflow_scene() result(scene)
       type(scene_t) :: scene
-      scene = water_scene(2, 0.1_rp, [3.0_rp, 2.0_rp, 0.0_rp], 2.0e6_rp, 10.0_rp)
-      scene%grid%wall = wall_none
-      scene%grid%wall(1, 2) = wall_slip
-      scene%grid%wall(2, 1) = wall_slip
-      allocate (scene%walls(1), scene%inlets(1))
-      scene%walls(1) = wall_spec_t(point=[0.0_rp, 0.5_rp, 0.0_rp], normal=[1.0_rp, 0.0_rp, 0.0_rp], &
-                                   lower=[0.0_rp, 0.5_rp, 0.0_rp], upper=[0.0_rp, 2.0_rp, 0.0_rp])
-      scene%inlets(1) = inlet_spec_t(material='water', material_index=1, point=[0.0_rp, 0.0_rp, 0.0_rp], &
-                                     direction=[1.0_rp, 0.0_rp, 0.0_rp], height=0.5_rp, velocity=2.0_rp, &
-                                     start_time=0.0_rp, end_time=0.1_rp, particles_per_cell=3)
+      scene = tank_with_inlet(0.5_rp, 2.0_rp, 0.1_rp)
       scene%run%cfl = 0.3_rp
    end function inflow_scene
 

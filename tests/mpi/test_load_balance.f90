@@ -1,0 +1,118 @@
+!> Load balancing (docs/theory.md section 6): scenes whose particles start in one part of the domain,
+!> run for 200 steps with and without rebalancing (as the time loop does it: at the start and every
+!> rebalance_interval steps). The diagnostics agree to round-off (relative 1e-10, as between rank
+!> counts: only the order of the particle-grid sums changes), the layout did change, and afterwards the
+!> largest rank holds at most 60 % of the particles on 2 ranks (a lower share than without on more).
+module test_load_balance
+   use kinds, only: rp, i8
+   use mpi_f08, only: MPI_Comm, MPI_Comm_size
+   use assertions, only: assertTrue, assertRelativelyEqual, assertEqual, assertLessThanOrEqual
+   use error_status, only: status_t
+   use scene_description, only: scene_t
+   use mpm_solver, only: solver_t
+   use run_diagnostics, only: diagnostics_t
+   use input_text, only: real_text
+   use test_scenes, only: water_scene, add_body, tank_with_inlet
+   implicit none
+   private
+
+   public :: test_collapsing_column_rebalanced, test_filling_tank_rebalanced
+
+   integer, parameter :: n_steps = 200
+
+contains
+
+   !> A 1 m x 1 m water column in the corner of a 4 m x 2 m box: on 2 ranks (split along x at 2 m)
+   !> all particles start on rank 0. Standard MPM and each stabilization scheme (their cell arrays
+   !> follow the new box).
+   subroutine test_collapsing_column_rebalanced(comm)
+      type(MPI_Comm), intent(in) :: comm
+      character(len=5), parameter :: schemes(4) = [character(len=5) :: 'none', 'C0', 'NB', 'FOAL1']
+      type(scene_t) :: scene
+      integer :: i
+      do i = 1, size(schemes)
+         scene = water_scene(2, 0.05_rp, [4.0_rp, 2.0_rp, 0.0_rp], 2.0e6_rp, 9.81_rp)
+         call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [1.0_rp, 1.0_rp, 0.0_rp], 2, .false., 0.0_rp)
+         scene%run%fixed_dt = 5.0e-4_rp
+         scene%materials(1)%stabilization = schemes(i)
+         call compare_with_and_without(comm, scene, 'collapsing column, '//trim(schemes(i)))
+      end do
+   end subroutine test_collapsing_column_rebalanced
+
+   !> A 3 m x 2 m tank filled through an opening 0.6 m high at the foot of the left wall: the walls'
+   !> node lists and the inlet's feeder are rebuilt for the new boxes, the new layers are created by
+   !> their new owners. On 2 ranks the uniform split is along x and the stream stays within the first
+   !> two columns for these 200 steps: only a split along y can share it. A fixed step, as in the
+   !> rank-count tests: with the CFL step this flow turns round-off into a jump of the step after ~170
+   !> steps (1e-7 in time at step 200), and does so between a uniform split along x and one along y
+   !> without any rebalancing too (measured), so it is not the rebalancing's doing.
+   subroutine test_filling_tank_rebalanced(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(scene_t) :: scene
+      scene = tank_with_inlet(0.6_rp, 1.0_rp, 1.0_rp)
+      scene%inlets(1)%hydrostatic = .true.
+      scene%run%fixed_dt = 4.0e-4_rp
+      call compare_with_and_without(comm, scene, 'filling tank')
+   end subroutine test_filling_tank_rebalanced
+
+   subroutine compare_with_and_without(comm, scene, label)
+      type(MPI_Comm), intent(in) :: comm
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: label
+      type(scene_t) :: fixed
+      type(diagnostics_t) :: off, on
+      integer, allocatable :: cuts_off(:, :), cuts_on(:, :)
+      integer :: nranks
+      character(len=:), allocatable :: what
+
+      call MPI_Comm_size(comm, nranks)
+      what = ' ('//label//')'
+      fixed = scene
+      fixed%run%rebalance_threshold = 0.0_rp
+      off = run_steps(comm, fixed, cuts_off)
+      on = run_steps(comm, scene, cuts_on)
+      call assertRelativelyEqual(off%time, on%time, 1.0e-12_rp, 'time'//what)
+      call assertEqual(off%particles, on%particles, 'particles'//what)
+      call assertTrue(on%particles > 0_i8, 'the scene has particles'//what)
+      call assertRelativelyEqual(off%total_mass, on%total_mass, 1.0e-12_rp, 'total mass'//what)
+      call assertRelativelyEqual(off%kinetic_energy, on%kinetic_energy, 1.0e-10_rp, 'kinetic energy'//what)
+      call assertTrue(on%kinetic_energy > 0.0_rp, 'the scene moved'//what)
+      call assertRelativelyEqual(off%fluid_volume, on%fluid_volume, 1.0e-10_rp, 'fluid volume'//what)
+      call assertRelativelyEqual(off%h_eq, on%h_eq, 1.0e-10_rp, 'h_eq'//what)
+      call assertRelativelyEqual(off%max_speed, on%max_speed, 1.0e-10_rp, 'max speed'//what)
+      call assertEqual(off%lost_particles, on%lost_particles, 'lost particles'//what)
+      if (nranks == 1) then
+         call assertTrue(all(cuts_on == cuts_off), 'one rank: nothing to balance'//what)
+         return
+      end if
+      call assertTrue(off%max_rank_share > 0.99_rp, 'without rebalancing one rank holds (nearly) all, share '// &
+                      real_text(off%max_rank_share)//what)
+      call assertTrue(any(cuts_on /= cuts_off), 'rebalancing moved the cuts'//what)
+      call assertTrue(on%max_rank_share < off%max_rank_share, 'rebalanced share '//real_text(on%max_rank_share)// &
+                      ' below '//real_text(off%max_rank_share)//what)
+      if (nranks == 2) call assertLessThanOrEqual(on%max_rank_share, 0.6_rp, &
+                                                  'largest share on 2 ranks <= 60 % after rebalancing'//what)
+   end subroutine compare_with_and_without
+
+   !> n_steps steps, balance checks as in the time loop (simulation.f90); the diagnostics and the cuts.
+   function run_steps(comm, scene, cuts) result(diag)
+      type(MPI_Comm), intent(in) :: comm
+      type(scene_t), intent(in) :: scene
+      integer, allocatable, intent(out) :: cuts(:, :)
+      type(diagnostics_t) :: diag
+      type(solver_t) :: solver
+      type(status_t) :: status
+      integer :: step
+      call solver%init(scene, comm, status)
+      call assertTrue(status%ok, 'solver init: '//trim(status%message))
+      call solver%balance_load(status)
+      do step = 1, n_steps
+         call solver%advance()
+         if (mod(solver%step, int(scene%run%rebalance_interval, i8)) == 0) call solver%balance_load(status)
+      end do
+      call assertTrue(status%ok, 'balance: '//trim(status%message))
+      diag = solver%diagnostics()
+      cuts = solver%domain%cuts
+      call solver%free()
+   end function run_steps
+end module test_load_balance
