@@ -45,7 +45,8 @@ def tank_cases(quick):
         "grid rotation [deg]": ("grid rotation", [0.0, 22.5, 45.0] if not quick else [22.5]),
         "CFL": ("run cfl", [0.05, 0.25, 0.5, 0.95] if not quick else [0.95]),
         "particles per cell": ("body particles_per_cell", [1, 2, 4, 6] if not quick else [1]),
-        "cells per 3.2 m": ("grid cell_size", [0.8, 0.2, 0.1, 0.05] if not quick else [0.8]),
+        "cell size [m]": ("grid cell_size", [0.8, 0.2, 0.1, 0.05] if not quick else [0.8]),
+        "FLIP fraction": ("run flip_fraction", [1.0] if not quick else []),
         "viscosity [Pa s]": ("material:water viscosity", [0.0, 1.0, 1.0e3] if not quick else [1.0e3]),
     }
     cases = []
