@@ -62,7 +62,7 @@ contains
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
       real(rp), allocatable :: q(:, :)
-      integer :: first, last, nq, dim, p, c, lo, hi
+      integer :: first, last, nq, dim, p, c, lo, hi, i
 
       first = context%first
       last = context%last
@@ -88,24 +88,30 @@ contains
 
          ! padded cell field: exists, m_c, x_o^c, q_c; ghost layers from the neighbours (collective). Rows
          ! other than "exists" are read only where it is set. Only the occupied range is written: first
-         ! clear the cells the last step wrote outside it (the rest of `field` stays 0 from allocation, or
-         ! is rewritten by every exchange).
+         ! clear the cells the last step wrote outside it (the rest of `field` and `exists` stays 0 from
+         ! allocation, or is rewritten by every exchange).
          do c = self%packed(1), min(self%packed(2), lo - 1)
             field(1, of_owned(c)) = 0.0_rp
+            exists(of_owned(c)) = .false.
          end do
          do c = max(self%packed(1), hi + 1), self%packed(2)
             field(1, of_owned(c)) = 0.0_rp
+            exists(of_owned(c)) = .false.
          end do
          if (dim == 2 .and. nq == 4) then
-            call pack_cells(2, 4, self%occupied, of_owned, self%cell_mass, self%centre, q_cell, field)
+            call pack_cells(2, 4, self%occupied, of_owned, self%cell_mass, self%centre, q_cell, field, exists)
          else if (dim == 3 .and. nq == 6) then
-            call pack_cells(3, 6, self%occupied, of_owned, self%cell_mass, self%centre, q_cell, field)
+            call pack_cells(3, 6, self%occupied, of_owned, self%cell_mass, self%centre, q_cell, field, exists)
          else
-            call pack_cells(dim, nq, self%occupied, of_owned, self%cell_mass, self%centre, q_cell, field)
+            call pack_cells(dim, nq, self%occupied, of_owned, self%cell_mass, self%centre, q_cell, field, exists)
          end if
          self%packed = self%occupied
          call exchange_cell_halo(context%domain, context%grid, self%box, field)
-         exists = field(1, :) > 0.5_rp
+         associate (ghost => self%box%ghost)
+            do i = 1, size(ghost)
+               exists(ghost(i)) = field(1, ghost(i)) > 0.5_rp
+            end do
+         end associate
 
          ! (d) limited face fluxes
          call limited_flux_increments(self%box, context%grid%h, exists, field(2, :), field(3:2 + dim, :), &
@@ -139,16 +145,18 @@ contains
    end subroutine foal1_filter_stress
 
    !> field(:, of_owned(c)) := [1, m_c, x_o^c, q_c] for the cells c of the occupied range holding the
-   !> material, field(1, of_owned(c)) := 0 for the others. dim and nq are literals at the calls that matter
-   !> (a section copy of unknown length per cell is a library call).
-   subroutine pack_cells(dim, nq, occupied, of_owned, cell_mass, centre, q_cell, field)
+   !> material, field(1, of_owned(c)) := 0 for the others; exists likewise. dim and nq are literals at the
+   !> calls that matter (a section copy of unknown length per cell is a library call).
+   subroutine pack_cells(dim, nq, occupied, of_owned, cell_mass, centre, q_cell, field, exists)
       integer, intent(in) :: dim, nq, occupied(2), of_owned(:)
       real(rp), intent(in) :: cell_mass(:), centre(dim, *), q_cell(nq, *)
       real(rp), intent(inout) :: field(2 + dim + nq, *)
+      logical, intent(inout) :: exists(:)
       integer :: c, i
       do c = occupied(1), occupied(2)
          i = of_owned(c)
-         if (cell_mass(c) > 0.0_rp) then
+         exists(i) = cell_mass(c) > 0.0_rp
+         if (exists(i)) then
             field(1, i) = 1.0_rp
             field(2, i) = cell_mass(c)
             field(3:2 + dim, i) = centre(:, c)
@@ -171,7 +179,7 @@ contains
    end subroutine add_increments
 
    !> Size the work arrays for nq smoothed values on the current cells (kept while the sizes hold). A new
-   !> `field` starts at 0: no cell exists, and ghost cells no exchange writes (beyond the grid) stay so.
+   !> `field` starts at 0 and `exists` false: ghost cells no exchange writes (beyond the grid) stay so.
    subroutine ensure_work_arrays(self, nq, dim, cell_count)
       type(foal1_smoothing_t), intent(inout) :: self
       integer, intent(in) :: nq, dim, cell_count
@@ -182,7 +190,9 @@ contains
       allocate (self%q_cell(nq, cell_count), self%field(2 + dim + nq, self%box%count), self%dq(nq, self%box%count), &
                 self%exists(self%box%count))
       self%field = 0.0_rp
+      self%exists = .false.
       self%packed = [1, 0]
+      self%workspace = flux_workspace_t()     ! it belongs to the old dq
    end subroutine ensure_work_arrays
 
    !> True if the padded box was built for the cells the grid owns now (they move when ranks rebalance).

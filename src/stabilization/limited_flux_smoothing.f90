@@ -35,9 +35,12 @@ module limited_flux_smoothing
    real(rp), parameter :: noise_guard = 1.0e-10_rp
 
    !> Work arrays of limited_flux_increments, kept between calls (a step must not page in fresh memory).
+   !> A workspace belongs to one dq array: it remembers which part of dq the last call may have made
+   !> non-zero, and the next call clears only that part (the rest of the box is air in a tank).
    type, public :: flux_workspace_t
       integer, allocatable :: oscillating(:)   !< bit j - 1 set: component j oscillates along the current axis
       real(rp), allocatable :: scale(:)
+      integer :: written(2) = [1, 0]           !< flat range of dq written by the last call
    end type flux_workspace_t
 
    public :: limited_flux_increments
@@ -46,7 +49,8 @@ contains
 
    !> dq(:, c) for every owned padded cell c (zero elsewhere). `exists` marks cells holding this material
    !> (owned and ghost); q(:, c), mass(c), centre(:, c) are read only where exists(c). `workspace` keeps
-   !> the work arrays between calls.
+   !> the work arrays between calls; a new one (or one last used with another dq) makes the call zero all
+   !> of dq first.
    !> The loops run over the bounding box of the existing cells row by row, with the limits along the axis
    !> in the loop bounds (no per-cell position tests). Faces are visited axis by axis in flat cell order,
    !> which fixes the order of the sums into dq.
@@ -56,18 +60,25 @@ contains
       logical, intent(in) :: exists(:)
       real(rp), intent(in) :: mass(:), centre(:, :), q(:, :)
       type(flux_options_t), intent(in) :: options
-      real(rp), intent(out) :: dq(:, :)
+      real(rp), intent(inout) :: dq(:, :)
       type(flux_workspace_t), intent(inout) :: workspace
       integer :: k, nq, c, stride, i1, i2, i3, lo(3), hi(3), flo(3), fhi(3)
 
       nq = size(q, 1)
-      dq = 0.0_rp
       if (allocated(workspace%oscillating)) then
          if (size(workspace%oscillating) /= box%count) deallocate (workspace%oscillating, workspace%scale)
       end if
-      if (.not. allocated(workspace%oscillating)) allocate (workspace%oscillating(box%count), workspace%scale(box%count))
+      if (allocated(workspace%oscillating)) then
+         dq(:, workspace%written(1):workspace%written(2)) = 0.0_rp
+      else
+         allocate (workspace%oscillating(box%count), workspace%scale(box%count))
+         dq = 0.0_rp
+      end if
       call existing_bounds(box, exists, lo, hi)
+      workspace%written = [1, 0]
       if (any(hi < lo)) return
+      ! every face flux goes to cells of the bounding box
+      workspace%written = [flat_index(box, lo(1), lo(2), lo(3)), flat_index(box, hi(1), hi(2), hi(3))]
       associate (oscillating => workspace%oscillating, scale => workspace%scale)
          do i3 = lo(3), hi(3)
             do i2 = lo(2), hi(2)
@@ -88,10 +99,11 @@ contains
             do i3 = flo(3), fhi(3)
                do i2 = flo(2), fhi(2)
                   c = flat_index(box, flo(1), i2, i3)
-                  do i1 = flo(1), fhi(1)
-                     oscillating(c) = oscillation_bits(exists, scale, q, c, stride)
-                     c = c + 1
-                  end do
+                  if (nq == 4) then     ! a literal count unrolls the components (2-D stress)
+                     call row_oscillation_bits(4, exists, scale, q, c, fhi(1) - flo(1) + 1, stride, oscillating)
+                  else
+                     call row_oscillation_bits(nq, exists, scale, q, c, fhi(1) - flo(1) + 1, stride, oscillating)
+                  end if
                end do
             end do
             ! faces (c, c + stride) with c two or more layers inside the box and c + stride in the bounding box
@@ -145,24 +157,28 @@ contains
       flat_index = 1 + (i1 - 1) + (i2 - 1) * box%stride(2) + (i3 - 1) * box%stride(3)
    end function flat_index
 
-   !> Eq. 6 per component for cell c along the axis of `stride`, as bits (bit j - 1: component j), with
-   !> the noise guard: both differences above round-off and of opposite sign. 0 if c or a neighbour is
-   !> missing (a cell missing a neighbour cannot be tested [?]).
-   pure integer function oscillation_bits(exists, scale, q, c, stride) result(bits)
+   !> Eq. 6 per component for the cells first..first + count - 1 along the axis of `stride`, as bits
+   !> (bit j - 1: component j), with the noise guard: both differences above round-off and of opposite
+   !> sign. 0 if the cell or a neighbour is missing (a cell missing a neighbour cannot be tested [?]).
+   subroutine row_oscillation_bits(nq, exists, scale, q, first, count, stride, oscillating)
+      integer, intent(in) :: nq, first, count, stride
       logical, intent(in) :: exists(:)
       real(rp), intent(in) :: scale(:), q(:, :)
-      integer, intent(in) :: c, stride
+      integer, intent(inout) :: oscillating(:)
       real(rp) :: noise, left, right
-      integer :: j
-      bits = 0
-      if (.not. (exists(c) .and. exists(c - stride) .and. exists(c + stride))) return
-      noise = max(scale(c - stride), scale(c), scale(c + stride))
-      do j = 1, size(q, 1)
-         left = q(j, c) - q(j, c - stride)
-         right = q(j, c + stride) - q(j, c)
-         if (abs(right) > noise .and. abs(left) > noise .and. right * left < 0.0_rp) bits = ibset(bits, j - 1)
+      integer :: j, c
+      do c = first, first + count - 1
+         oscillating(c) = 0
+         if (.not. (exists(c) .and. exists(c - stride) .and. exists(c + stride))) cycle
+         noise = max(scale(c - stride), scale(c), scale(c + stride))
+         do j = 1, nq
+            left = q(j, c) - q(j, c - stride)
+            right = q(j, c + stride) - q(j, c)
+            if (abs(right) > noise .and. abs(left) > noise .and. right * left < 0.0_rp) &
+               oscillating(c) = ibset(oscillating(c), j - 1)
+         end do
       end do
-   end function oscillation_bits
+   end subroutine row_oscillation_bits
 
    !> The limited flux across the face (c, c + stride of axis k), if both cells exist, at least one is
    !> owned, and the face is active for some component; added to dq of the owned side(s).
