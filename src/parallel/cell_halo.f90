@@ -24,6 +24,7 @@ module cell_halo
       integer :: stride(3) = 1                   !< flat-index step along each axis
       integer, allocatable :: of_owned(:)        !< padded index of each owned (grid-local) cell
       logical, allocatable :: owned(:)           !< padded cell is owned by this rank
+      integer, allocatable :: ghost(:)           !< padded index of every ghost cell an exchange may write
    contains
       procedure :: init => padded_init
       procedure :: index_of => padded_index_of
@@ -36,7 +37,7 @@ contains
    subroutine padded_init(self, grid)
       class(padded_cells_t), intent(inout) :: self
       type(grid_t), intent(in) :: grid
-      integer :: i, j, l, c(3), owned_index
+      integer :: i, j, l, c(3), owned_index, k, side, lo(3), hi(3), n_ghost
       self%dim = grid%dim
       self%lo = grid%cell_lo
       self%hi = grid%cell_hi
@@ -45,7 +46,7 @@ contains
       self%n = self%hi - self%lo + 1
       self%count = product(self%n)
       self%stride = [1, self%n(1), self%n(1) * self%n(2)]
-      if (allocated(self%of_owned)) deallocate (self%of_owned, self%owned)
+      if (allocated(self%of_owned)) deallocate (self%of_owned, self%owned, self%ghost)
       allocate (self%of_owned(grid%cell_count), self%owned(self%count))
       self%owned = .false.
       owned_index = 0
@@ -56,6 +57,25 @@ contains
                owned_index = owned_index + 1     ! the order of grid%local_cell: x fastest
                self%of_owned(owned_index) = self%index_of(c)
                self%owned(self%of_owned(owned_index)) = .true.
+            end do
+         end do
+      end do
+      ! the ghost layers as exchange_cell_halo fills them: along each axis, over the owned extent of the others
+      allocate (self%ghost(sum([(2 * halo_width * (grid%cell_count / grid%n_cells(k)), k = 1, grid%dim)])))
+      n_ghost = 0
+      do k = 1, grid%dim
+         do side = 1, 2
+            lo = grid%cell_lo
+            hi = grid%cell_hi
+            lo(k) = merge(grid%cell_lo(k) - halo_width, grid%cell_hi(k) + 1, side == 1)
+            hi(k) = lo(k) + halo_width - 1
+            do l = lo(3), hi(3)
+               do j = lo(2), hi(2)
+                  do i = lo(1), hi(1)
+                     n_ghost = n_ghost + 1
+                     self%ghost(n_ghost) = self%index_of([i, j, l])
+                  end do
+               end do
             end do
          end do
       end do

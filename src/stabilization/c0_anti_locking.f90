@@ -11,13 +11,14 @@ module c0_anti_locking
    use kinds, only: rp
    use particle_set, only: particle_set_t
    use stabilizer, only: stabilizer_t, stage_context_t
-   use cell_binning, only: bin_cell_mass, replace_by_cell_average
+   use cell_binning, only: occupied_cells, bin_cell_mass, replace_by_cell_average
    implicit none
    private
 
    type, extends(stabilizer_t), public :: c0_anti_locking_t
       logical :: volumetric_only = .false.
-      real(rp), allocatable :: cell_mass(:)      !< m_c of the owned cells (this material)
+      integer :: occupied(2) = [1, 0]            !< lowest, highest owned cell holding the material at x^n
+      real(rp), allocatable :: cell_mass(:)      !< m_c of the owned cells (this material; occupied ones only)
       real(rp), allocatable :: average(:, :)     !< work: cell averages (kept between steps)
    contains
       procedure :: prepare => c0_prepare
@@ -34,8 +35,8 @@ contains
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
       call self%size_cell_arrays(context%grid%cell_count, particles%n_sigma)
-      call bin_cell_mass(particles, context%first, context%last, &
-                         self%cell_mass)
+      self%occupied = occupied_cells(particles, context%first, context%last)
+      call bin_cell_mass(particles, context%first, context%last, self%occupied, self%cell_mass)
    end subroutine c0_prepare
 
    !> (Re)allocate the per-cell arrays when the rank's cells change.
@@ -80,7 +81,8 @@ contains
       if (self%volumetric_only) then
          call replace_volumetric_part(self, particles, first, last, tensors(:, first:last), n_normal)
       else
-         call replace_by_cell_average(particles, first, last, self%cell_mass, tensors(:, first:last), self%average)
+         call replace_by_cell_average(particles, first, last, self%occupied, self%cell_mass, tensors(:, first:last), &
+                                      self%average)
       end if
    end subroutine filter_slice
 
@@ -97,7 +99,7 @@ contains
       do p = 1, last - first + 1
          mean(1, p) = sum(tensors(1:n_normal, p)) / n_normal
       end do
-      call replace_by_cell_average(particles, first, last, self%cell_mass, mean, self%average)
+      call replace_by_cell_average(particles, first, last, self%occupied, self%cell_mass, mean, self%average)
       do p = 1, last - first + 1
          tensors(1:n_normal, p) = tensors(1:n_normal, p) - sum(tensors(1:n_normal, p)) / n_normal + mean(1, p)
       end do

@@ -13,7 +13,7 @@ module foal1_smoothing
    use particle_set, only: particle_set_t
    use stabilizer, only: stage_context_t
    use c0_anti_locking, only: c0_anti_locking_t
-   use cell_binning, only: bin_cell_mass_and_centre, cell_average
+   use cell_binning, only: occupied_cells, bin_cell_mass_and_centre, cell_average, gather_cell_values
    use cell_halo, only: padded_cells_t, exchange_cell_halo, halo_width
    use background_grid, only: grid_t
    use limited_flux_smoothing, only: flux_options_t, flux_workspace_t, limited_flux_increments
@@ -25,10 +25,11 @@ module foal1_smoothing
       logical :: pressure_only = .false.       !< smooth p / rho only, not every stress component
       logical :: cell_averaging = .true.       !< step (c); off: purely incremental update
       type(padded_cells_t) :: box
-      real(rp), allocatable :: centre(:, :)    !< mass centre x_o^c of the owned cells at x^n
+      real(rp), allocatable :: centre(:, :)    !< mass centre x_o^c of the owned cells at x^n (occupied ones)
       ! work arrays kept between steps
       real(rp), allocatable :: q_cell(:, :), field(:, :), dq(:, :)
       logical, allocatable :: exists(:)
+      integer :: packed(2) = [1, 0]            !< owned cells written into `field` by the last step
       type(flux_workspace_t) :: workspace
    contains
       procedure :: prepare => foal1_prepare
@@ -43,12 +44,16 @@ contains
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
       call self%size_cell_arrays(context%grid%cell_count, particles%n_sigma)
-      if (.not. same_cells(self%box, context%grid)) call self%box%init(context%grid)
+      if (.not. same_cells(self%box, context%grid)) then
+         call self%box%init(context%grid)
+         if (allocated(self%q_cell)) deallocate (self%q_cell, self%field, self%dq, self%exists)   ! a new layout
+      end if
       if (allocated(self%centre)) then
          if (size(self%centre, 2) /= context%grid%cell_count) deallocate (self%centre)
       end if
       if (.not. allocated(self%centre)) allocate (self%centre(context%grid%dim, context%grid%cell_count))
-      call bin_cell_mass_and_centre(particles, context%first, context%last, self%cell_mass, self%centre)
+      self%occupied = occupied_cells(particles, context%first, context%last)
+      call bin_cell_mass_and_centre(particles, context%first, context%last, self%occupied, self%cell_mass, self%centre)
    end subroutine foal1_prepare
 
    !> Steps (c) to (e) for the material's particles.
@@ -57,72 +62,124 @@ contains
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
       real(rp), allocatable :: q(:, :)
-      integer :: first, last, nq, dim, p, i, c, row_q
+      integer :: first, last, nq, dim, p, c, lo, hi, i
 
       first = context%first
       last = context%last
       dim = context%grid%dim
       nq = merge(1, particles%n_sigma, self%pressure_only)
+      lo = self%occupied(1)
+      hi = self%occupied(2)
 
       call ensure_work_arrays(self, nq, dim, context%grid%cell_count)
 
       ! (c) cell averages of q on the owned cells
-      associate (q_cell => self%q_cell, field => self%field, dq => self%dq, exists => self%exists)
+      associate (q_cell => self%q_cell, field => self%field, dq => self%dq, exists => self%exists, &
+                 of_owned => self%box%of_owned)
          if (self%pressure_only) then
             allocate (q(nq, max(0, last - first + 1)))
             do p = first, last
                q(1, p - first + 1) = -(particles%sbar(1, p) + particles%sbar(2, p) + particles%sbar(3, p)) / 3.0_rp
             end do
-            call cell_average(particles, first, last, self%cell_mass, q, q_cell)
+            call cell_average(particles, first, last, self%occupied, self%cell_mass, q, q_cell)
          else
-            call cell_average(particles, first, last, self%cell_mass, particles%sbar(:, first:last), q_cell)
+            call cell_average(particles, first, last, self%occupied, self%cell_mass, particles%sbar(:, first:last), q_cell)
          end if
 
-         ! padded cell field: exists, m_c, x_o^c, q_c; ghost layers from the neighbours (collective)
-         row_q = 3 + dim
-         field(1, :) = 0.0_rp      ! "exists"; the other rows are read only where it is set
-         do c = 1, context%grid%cell_count
-            if (self%cell_mass(c) <= 0.0_rp) cycle
-            i = self%box%of_owned(c)
-            field(1, i) = 1.0_rp
-            field(2, i) = self%cell_mass(c)
-            field(3:2 + dim, i) = self%centre(:, c)
-            field(row_q:, i) = q_cell(:, c)
+         ! padded cell field: exists, m_c, x_o^c, q_c; ghost layers from the neighbours (collective). Rows
+         ! other than "exists" are read only where it is set. Only the occupied range is written: first
+         ! clear the cells the last step wrote outside it (the rest of `field` and `exists` stays 0 from
+         ! allocation, or is rewritten by every exchange).
+         do c = self%packed(1), min(self%packed(2), lo - 1)
+            field(1, of_owned(c)) = 0.0_rp
+            exists(of_owned(c)) = .false.
          end do
+         do c = max(self%packed(1), hi + 1), self%packed(2)
+            field(1, of_owned(c)) = 0.0_rp
+            exists(of_owned(c)) = .false.
+         end do
+         if (dim == 2 .and. nq == 4) then
+            call pack_cells(2, 4, self%occupied, of_owned, self%cell_mass, self%centre, q_cell, field, exists)
+         else if (dim == 3 .and. nq == 6) then
+            call pack_cells(3, 6, self%occupied, of_owned, self%cell_mass, self%centre, q_cell, field, exists)
+         else
+            call pack_cells(dim, nq, self%occupied, of_owned, self%cell_mass, self%centre, q_cell, field, exists)
+         end if
+         self%packed = self%occupied
          call exchange_cell_halo(context%domain, context%grid, self%box, field)
-         exists = field(1, :) > 0.5_rp
+         associate (ghost => self%box%ghost)
+            do i = 1, size(ghost)
+               exists(ghost(i)) = field(1, ghost(i)) > 0.5_rp
+            end do
+         end associate
 
          ! (d) limited face fluxes
          call limited_flux_increments(self%box, context%grid%h, exists, field(2, :), field(3:2 + dim, :), &
-                                   field(row_q:, :), self%options, dq, self%workspace)
+                                      field(3 + dim:, :), self%options, dq, self%workspace)
 
          ! (e) particle update
          if (self%pressure_only) then
             ! q = p / rho = -tr(s) / 3: its increment enters the normal components with opposite sign
             if (self%cell_averaging) &
-            call cell_average(particles, first, last, self%cell_mass, particles%sbar(:, first:last), self%average)
+               call cell_average(particles, first, last, self%occupied, self%cell_mass, particles%sbar(:, first:last), &
+                                 self%average)
             do p = first, last
                c = particles%cell(p)
                if (self%cell_averaging) particles%sbar(:, p) = self%average(:, c)
-               particles%sbar(1:3, p) = particles%sbar(1:3, p) - dq(1, self%box%of_owned(c))
+               particles%sbar(1:3, p) = particles%sbar(1:3, p) - dq(1, of_owned(c))
             end do
          else if (self%cell_averaging) then
             ! q^_c = q_c + dq_c per owned cell (eq. 13), then a plain gather
-            do c = 1, context%grid%cell_count
-               if (self%cell_mass(c) > 0.0_rp) q_cell(:, c) = q_cell(:, c) + dq(:, self%box%of_owned(c))
-            end do
-            do p = first, last
-               particles%sbar(:, p) = q_cell(:, particles%cell(p))
-            end do
+            if (nq == 4) then
+               call add_increments(4, self%occupied, of_owned, self%cell_mass, dq, q_cell)
+            else
+               call add_increments(nq, self%occupied, of_owned, self%cell_mass, dq, q_cell)
+            end if
+            call gather_cell_values(particles%cell(first:last), q_cell, particles%sbar(:, first:last))
          else
             do p = first, last
-               particles%sbar(:, p) = particles%sbar(:, p) + dq(:, self%box%of_owned(particles%cell(p)))
+               particles%sbar(:, p) = particles%sbar(:, p) + dq(:, of_owned(particles%cell(p)))
             end do
          end if
       end associate
    end subroutine foal1_filter_stress
 
-   !> Size the work arrays for nq smoothed values on the current cells (kept while the sizes hold).
+   !> field(:, of_owned(c)) := [1, m_c, x_o^c, q_c] for the cells c of the occupied range holding the
+   !> material, field(1, of_owned(c)) := 0 for the others; exists likewise. dim and nq are literals at the
+   !> calls that matter (a section copy of unknown length per cell is a library call).
+   subroutine pack_cells(dim, nq, occupied, of_owned, cell_mass, centre, q_cell, field, exists)
+      integer, intent(in) :: dim, nq, occupied(2), of_owned(:)
+      real(rp), intent(in) :: cell_mass(:), centre(dim, *), q_cell(nq, *)
+      real(rp), intent(inout) :: field(2 + dim + nq, *)
+      logical, intent(inout) :: exists(:)
+      integer :: c, i
+      do c = occupied(1), occupied(2)
+         i = of_owned(c)
+         exists(i) = cell_mass(c) > 0.0_rp
+         if (exists(i)) then
+            field(1, i) = 1.0_rp
+            field(2, i) = cell_mass(c)
+            field(3:2 + dim, i) = centre(:, c)
+            field(3 + dim:, i) = q_cell(:, c)
+         else
+            field(1, i) = 0.0_rp
+         end if
+      end do
+   end subroutine pack_cells
+
+   !> q_cell(:, c) := q_c + dq_c (eq. 13) for the occupied cells holding the material.
+   subroutine add_increments(nq, occupied, of_owned, cell_mass, dq, q_cell)
+      integer, intent(in) :: nq, occupied(2), of_owned(:)
+      real(rp), intent(in) :: cell_mass(:), dq(nq, *)
+      real(rp), intent(inout) :: q_cell(nq, *)
+      integer :: c
+      do c = occupied(1), occupied(2)
+         if (cell_mass(c) > 0.0_rp) q_cell(:, c) = q_cell(:, c) + dq(:, of_owned(c))
+      end do
+   end subroutine add_increments
+
+   !> Size the work arrays for nq smoothed values on the current cells (kept while the sizes hold). A new
+   !> `field` starts at 0 and `exists` false: ghost cells no exchange writes (beyond the grid) stay so.
    subroutine ensure_work_arrays(self, nq, dim, cell_count)
       type(foal1_smoothing_t), intent(inout) :: self
       integer, intent(in) :: nq, dim, cell_count
@@ -132,6 +189,10 @@ contains
       end if
       allocate (self%q_cell(nq, cell_count), self%field(2 + dim + nq, self%box%count), self%dq(nq, self%box%count), &
                 self%exists(self%box%count))
+      self%field = 0.0_rp
+      self%exists = .false.
+      self%packed = [1, 0]
+      self%workspace = flux_workspace_t()     ! it belongs to the old dq
    end subroutine ensure_work_arrays
 
    !> True if the padded box was built for the cells the grid owns now (they move when ranks rebalance).

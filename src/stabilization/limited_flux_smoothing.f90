@@ -35,9 +35,12 @@ module limited_flux_smoothing
    real(rp), parameter :: noise_guard = 1.0e-10_rp
 
    !> Work arrays of limited_flux_increments, kept between calls (a step must not page in fresh memory).
+   !> A workspace belongs to one dq array: it remembers which part of dq the last call may have made
+   !> non-zero, and the next call clears only that part (the rest of the box is air in a tank).
    type, public :: flux_workspace_t
-      logical, allocatable :: oscillating(:, :)
+      integer, allocatable :: oscillating(:)   !< bit j - 1 set: component j oscillates along the current axis
       real(rp), allocatable :: scale(:)
+      integer :: written(2) = [1, 0]           !< flat range of dq written by the last call
    end type flux_workspace_t
 
    public :: limited_flux_increments
@@ -46,112 +49,178 @@ contains
 
    !> dq(:, c) for every owned padded cell c (zero elsewhere). `exists` marks cells holding this material
    !> (owned and ghost); q(:, c), mass(c), centre(:, c) are read only where exists(c). `workspace` keeps
-   !> the work arrays between calls.
+   !> the work arrays between calls; a new one (or one last used with another dq) makes the call zero all
+   !> of dq first.
+   !> The loops run over the bounding box of the existing cells row by row, with the limits along the axis
+   !> in the loop bounds (no per-cell position tests). Faces are visited axis by axis in flat cell order,
+   !> which fixes the order of the sums into dq.
    subroutine limited_flux_increments(box, h, exists, mass, centre, q, options, dq, workspace)
       type(padded_cells_t), intent(in) :: box
       real(rp), intent(in) :: h
       logical, intent(in) :: exists(:)
       real(rp), intent(in) :: mass(:), centre(:, :), q(:, :)
       type(flux_options_t), intent(in) :: options
-      real(rp), intent(out) :: dq(:, :)
+      real(rp), intent(inout) :: dq(:, :)
       type(flux_workspace_t), intent(inout) :: workspace
-      integer :: k, nq, c, stride, along, j, i1, i2, i3, position(3), lo(3), hi(3)
-      real(rp) :: n_faces, flux, jump, limited_jump, x_m, allowed, d_min, slope_minus(size(q, 1)), &
-                  slope_plus(size(q, 1)), noise, left, right
-      logical :: active
+      integer :: k, nq, c, stride, i1, i2, i3, lo(3), hi(3), flo(3), fhi(3)
 
       nq = size(q, 1)
-      n_faces = real(2 * box%dim, rp)
-      d_min = min_centre_distance * h
-      dq = 0.0_rp
       if (allocated(workspace%oscillating)) then
-         if (any(shape(workspace%oscillating) /= [nq, box%count])) deallocate (workspace%oscillating, workspace%scale)
+         if (size(workspace%oscillating) /= box%count) deallocate (workspace%oscillating, workspace%scale)
       end if
-      if (.not. allocated(workspace%oscillating)) &
-         allocate (workspace%oscillating(nq, box%count), workspace%scale(box%count))
+      if (allocated(workspace%oscillating)) then
+         dq(:, workspace%written(1):workspace%written(2)) = 0.0_rp
+      else
+         allocate (workspace%oscillating(box%count), workspace%scale(box%count))
+         dq = 0.0_rp
+      end if
+      call existing_bounds(box, exists, lo, hi)
+      workspace%written = [1, 0]
+      if (any(hi < lo)) return
+      ! every face flux goes to cells of the bounding box
+      workspace%written = [flat_index(box, lo(1), lo(2), lo(3)), flat_index(box, hi(1), hi(2), hi(3))]
       associate (oscillating => workspace%oscillating, scale => workspace%scale)
-         ! the loops below only visit the bounding box of the existing cells (cost follows the material)
-         lo = box%n
-         hi = 1
-         c = 0
-         do i3 = 1, box%n(3)
-            do i2 = 1, box%n(2)
-               do i1 = 1, box%n(1)
+         do i3 = lo(3), hi(3)
+            do i2 = lo(2), hi(2)
+               c = flat_index(box, lo(1), i2, i3)
+               do i1 = lo(1), hi(1)
+                  if (exists(c)) scale(c) = noise_guard * maxval(abs(q(:, c)))     ! round-off scale (see noise_guard)
                   c = c + 1
-                  if (.not. exists(c)) cycle
-                  position = [i1, i2, i3]
-                  lo = min(lo, position)
-                  hi = max(hi, position)
-                  scale(c) = noise_guard * maxval(abs(q(:, c)))     ! round-off scale (see noise_guard)
                end do
             end do
          end do
          do k = 1, box%dim
             stride = box%stride(k)
-            ! oscillation flags (eq. 6) of every cell with both neighbours inside the padded box
-            do i3 = lo(3), hi(3)
-               do i2 = lo(2), hi(2)
-                  do i1 = lo(1), hi(1)
-                     c = 1 + (i1 - 1) + (i2 - 1) * box%stride(2) + (i3 - 1) * box%stride(3)
-                     if (.not. exists(c)) cycle
-                     position = [i1, i2, i3]
-                     along = position(k)
-                     if (along == 1 .or. along == box%n(k)) then
-                        oscillating(:, c) = .false.
-                     else if (exists(c - stride) .and. exists(c + stride)) then
-                        ! eq. 6 with the noise guard: both differences above round-off and of opposite sign
-                        noise = max(scale(c - stride), scale(c), scale(c + stride))
-                        do j = 1, nq
-                           left = q(j, c) - q(j, c - stride)
-                           right = q(j, c + stride) - q(j, c)
-                           oscillating(j, c) = abs(right) > noise .and. abs(left) > noise .and. right * left < 0.0_rp
-                        end do
-                     else
-                        oscillating(:, c) = .false.     ! a cell missing a neighbour cannot be tested [?]
-                     end if
-                  end do
+            ! oscillation flags (eq. 6) of the cells with both neighbours along k inside the padded box
+            flo = lo
+            fhi = hi
+            flo(k) = max(lo(k), 2)
+            fhi(k) = min(hi(k), box%n(k) - 1)
+            do i3 = flo(3), fhi(3)
+               do i2 = flo(2), fhi(2)
+                  c = flat_index(box, flo(1), i2, i3)
+                  if (nq == 4) then     ! a literal count unrolls the components (2-D stress)
+                     call row_oscillation_bits(4, exists, scale, q, c, fhi(1) - flo(1) + 1, stride, oscillating)
+                  else
+                     call row_oscillation_bits(nq, exists, scale, q, c, fhi(1) - flo(1) + 1, stride, oscillating)
+                  end if
                end do
             end do
-            ! faces (c, c + stride) with both cells present, at least one owned, and an oscillating cell
-            do i3 = lo(3), hi(3)
-               do i2 = lo(2), hi(2)
-                  do i1 = lo(1), hi(1)
-                     c = 1 + (i1 - 1) + (i2 - 1) * box%stride(2) + (i3 - 1) * box%stride(3)
-                     if (.not. exists(c)) cycle
-                     position = [i1, i2, i3]
-                     along = position(k)
-                     if (along < 2 .or. along > box%n(k) - 2) cycle
-                     if (.not. exists(c + stride)) cycle
-                     if (.not. (box%owned(c) .or. box%owned(c + stride))) cycle
-                     if (.not. (any(oscillating(:, c)) .or. any(oscillating(:, c + stride)))) cycle
-                     ! slopes (eq. 7) of the two cells, only for the faces that can carry a flux
-                     call cell_slope(box, exists, centre, q, c, k, d_min, slope_minus)
-                     call cell_slope(box, exists, centre, q, c + stride, k, d_min, slope_plus)
-                     associate (m_minus => mass(c), m_plus => mass(c + stride), &
-                             x_minus => centre(k, c), x_plus => centre(k, c + stride))
-                        x_m = (m_minus * x_plus + m_plus * x_minus) / (m_minus + m_plus)         ! eq. 8
-                        do j = 1, nq
-                           ! oscillation limiter (eq. 6): gamma_o = gamma_max on an active face, else no flux
-                           if (options%both_cells_oscillate) then
-                              active = oscillating(j, c) .and. oscillating(j, c + stride)
-                           else
-                              active = oscillating(j, c) .or. oscillating(j, c + stride)
-                           end if
-                           if (.not. active) cycle
-                           jump = q(j, c) - q(j, c + stride)
-                           allowed = (x_m - x_minus) * slope_minus(j) - (x_m - x_plus) * slope_plus(j)   ! e_- - e_+
-                           limited_jump = sign0(jump) * min(max(sign0(jump) * (jump + allowed), 0.0_rp), abs(jump))  ! eq. 12
-                           flux = options%gamma_max * limited_jump / (n_faces * (m_minus + m_plus))   ! eqs. 5, 11, 1/n
-                           if (box%owned(c + stride)) dq(j, c + stride) = dq(j, c + stride) + m_minus * flux
-                           if (box%owned(c)) dq(j, c) = dq(j, c) - m_plus * flux
-                        end do
-                     end associate
+            ! faces (c, c + stride) with c two or more layers inside the box and c + stride in the bounding box
+            flo(k) = max(lo(k), 2)
+            fhi(k) = min(hi(k) - 1, box%n(k) - 2)
+            do i3 = flo(3), fhi(3)
+               do i2 = flo(2), fhi(2)
+                  c = flat_index(box, flo(1), i2, i3)
+                  do i1 = flo(1), fhi(1)
+                     if (ior(oscillating(c), oscillating(c + stride)) /= 0) &
+                        call face_flux(box, h, exists, mass, centre, q, options, oscillating, c, k, dq)
+                     c = c + 1
                   end do
                end do
             end do
          end do
       end associate
    end subroutine limited_flux_increments
+
+   !> Bounding box lo:hi (padded coordinates) of the existing cells; hi < lo if there are none.
+   subroutine existing_bounds(box, exists, lo, hi)
+      type(padded_cells_t), intent(in) :: box
+      logical, intent(in) :: exists(:)
+      integer, intent(out) :: lo(3), hi(3)
+      integer :: i1, i2, i3, c
+      lo = box%n
+      hi = 1
+      hi(1:box%dim) = 0
+      c = 0
+      do i3 = 1, box%n(3)
+         do i2 = 1, box%n(2)
+            if (.not. any(exists(c + 1:c + box%n(1)))) then
+               c = c + box%n(1)
+               cycle
+            end if
+            lo(2:3) = min(lo(2:3), [i2, i3])
+            hi(2:3) = max(hi(2:3), [i2, i3])
+            do i1 = 1, box%n(1)
+               c = c + 1
+               if (.not. exists(c)) cycle
+               lo(1) = min(lo(1), i1)
+               hi(1) = max(hi(1), i1)
+            end do
+         end do
+      end do
+   end subroutine existing_bounds
+
+   pure integer function flat_index(box, i1, i2, i3)
+      type(padded_cells_t), intent(in) :: box
+      integer, intent(in) :: i1, i2, i3
+      flat_index = 1 + (i1 - 1) + (i2 - 1) * box%stride(2) + (i3 - 1) * box%stride(3)
+   end function flat_index
+
+   !> Eq. 6 per component for the cells first..first + count - 1 along the axis of `stride`, as bits
+   !> (bit j - 1: component j), with the noise guard: both differences above round-off and of opposite
+   !> sign. 0 if the cell or a neighbour is missing (a cell missing a neighbour cannot be tested [?]).
+   subroutine row_oscillation_bits(nq, exists, scale, q, first, count, stride, oscillating)
+      integer, intent(in) :: nq, first, count, stride
+      logical, intent(in) :: exists(:)
+      real(rp), intent(in) :: scale(:), q(:, :)
+      integer, intent(inout) :: oscillating(:)
+      real(rp) :: noise, left, right
+      integer :: j, c
+      do c = first, first + count - 1
+         oscillating(c) = 0
+         if (.not. (exists(c) .and. exists(c - stride) .and. exists(c + stride))) cycle
+         noise = max(scale(c - stride), scale(c), scale(c + stride))
+         do j = 1, nq
+            left = q(j, c) - q(j, c - stride)
+            right = q(j, c + stride) - q(j, c)
+            if (abs(right) > noise .and. abs(left) > noise .and. right * left < 0.0_rp) &
+               oscillating(c) = ibset(oscillating(c), j - 1)
+         end do
+      end do
+   end subroutine row_oscillation_bits
+
+   !> The limited flux across the face (c, c + stride of axis k), if both cells exist, at least one is
+   !> owned, and the face is active for some component; added to dq of the owned side(s).
+   subroutine face_flux(box, h, exists, mass, centre, q, options, oscillating, c, k, dq)
+      type(padded_cells_t), intent(in) :: box
+      real(rp), intent(in) :: h
+      logical, intent(in) :: exists(:)
+      real(rp), intent(in) :: mass(:), centre(:, :), q(:, :)
+      type(flux_options_t), intent(in) :: options
+      integer, intent(in) :: oscillating(:), c, k
+      real(rp), intent(inout) :: dq(:, :)
+      integer :: j, right, active
+      real(rp) :: n_faces, flux, jump, limited_jump, x_m, allowed, d_min, slope_minus(size(q, 1)), &
+                  slope_plus(size(q, 1))
+      right = c + box%stride(k)
+      if (.not. (exists(c) .and. exists(right))) return
+      if (.not. (box%owned(c) .or. box%owned(right))) return
+      ! oscillation limiter (eq. 6): gamma_o = gamma_max on an active face, else no flux
+      if (options%both_cells_oscillate) then
+         active = iand(oscillating(c), oscillating(right))
+      else
+         active = ior(oscillating(c), oscillating(right))
+      end if
+      if (active == 0) return
+      n_faces = real(2 * box%dim, rp)
+      d_min = min_centre_distance * h
+      ! slopes (eq. 7) of the two cells, only for the faces that can carry a flux
+      call cell_slope(box, exists, centre, q, c, k, d_min, slope_minus)
+      call cell_slope(box, exists, centre, q, right, k, d_min, slope_plus)
+      associate (m_minus => mass(c), m_plus => mass(right), x_minus => centre(k, c), x_plus => centre(k, right))
+         x_m = (m_minus * x_plus + m_plus * x_minus) / (m_minus + m_plus)         ! eq. 8
+         do j = 1, size(q, 1)
+            if (.not. btest(active, j - 1)) cycle
+            jump = q(j, c) - q(j, right)
+            allowed = (x_m - x_minus) * slope_minus(j) - (x_m - x_plus) * slope_plus(j)   ! e_- - e_+
+            limited_jump = sign0(jump) * min(max(sign0(jump) * (jump + allowed), 0.0_rp), abs(jump))  ! eq. 12
+            flux = options%gamma_max * limited_jump / (n_faces * (m_minus + m_plus))   ! eqs. 5, 11, 1/n
+            if (box%owned(right)) dq(j, right) = dq(j, right) + m_minus * flux
+            if (box%owned(c)) dq(j, c) = dq(j, c) - m_plus * flux
+         end do
+      end associate
+   end subroutine face_flux
 
 
    !> Eq. 7 slope along axis k of cell c (of a face that lies inside the padded box, so both of c's
