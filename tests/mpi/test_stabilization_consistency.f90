@@ -19,7 +19,8 @@ module test_stabilization_consistency
    implicit none
    private
 
-   public :: test_conservation_per_material, test_random_field_rank_invariance, test_checkerboard_rank_invariance, &
+   public :: test_c0_volumetric_only, &
+             test_conservation_per_material, test_random_field_rank_invariance, test_checkerboard_rank_invariance, &
              test_random_field_3d_rank_invariance, &
              test_gamma_zero_is_c0, test_c0_is_one_point_quadrature_2d
 
@@ -179,6 +180,65 @@ contains
       end do
       call solver%free()
    end subroutine test_conservation_per_material
+
+   !> C0 with volumetric_only: the mean normal stress becomes its cell's mass-weighted mean (so the sum of
+   !> m_p times it is kept), and every particle keeps its deviatoric stress.
+   subroutine test_c0_volumetric_only(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(solver_t), target :: solver
+      type(scene_t) :: scene
+      type(status_t) :: status
+      type(stage_context_t) :: context
+      real(rp), allocatable :: deviator(:, :)
+      real(rp) :: before(2), after(2), mean, spread
+      integer :: p, c, q
+      scene = block_scene(2, 'C0')
+      scene%materials(1)%volumetric_only = .true.
+      call solver%init(scene, comm, status)
+      call assertTrue(status%ok, 'solver init: '//trim(status%message))
+      allocate (deviator(4, solver%particles%count))
+      do p = 1, solver%particles%count
+         solver%particles%sbar(:, p) = value_of(solver%particles%id(p), [0, 0, 0], random_field, 4)
+         mean = sum(solver%particles%sbar(1:3, p)) / 3.0_rp
+         deviator(:, p) = solver%particles%sbar(:, p) - [mean, mean, mean, 0.0_rp]
+      end do
+      before = volumetric_sums(solver, comm)
+      context%domain => solver%domain
+      context%grid => solver%grid
+      context%first = solver%particles%material_first(1)
+      context%last = solver%particles%material_last(1)
+      call solver%schemes(1)%scheme%prepare(context, solver%particles)
+      call solver%schemes(1)%scheme%filter_stress(context, solver%particles)
+      after = volumetric_sums(solver, comm)
+      call assertEqual(before(1), after(1), 1.0e-13_rp * before(2), 'sum m_p mean stress kept')
+      spread = 0.0_rp
+      do p = 1, solver%particles%count
+         mean = sum(solver%particles%sbar(1:3, p)) / 3.0_rp
+         spread = max(spread, maxval(abs(solver%particles%sbar(:, p) - [mean, mean, mean, 0.0_rp] - deviator(:, p))))
+         c = solver%particles%cell(p)
+         do q = p + 1, min(p + 8, solver%particles%count)      ! particles of one cell share one mean
+            if (solver%particles%cell(q) /= c) cycle
+            call assertEqual(mean, sum(solver%particles%sbar(1:3, q)) / 3.0_rp, 1.0e-12_rp * before(2) / &
+                             solver%particles%mass(p), 'one mean per cell')
+         end do
+      end do
+      call assertTrue(spread < 1.0e-12_rp * before(2) / solver%particles%mass(1), 'deviatoric stress kept')
+      call solver%free()
+   end subroutine test_c0_volumetric_only
+
+   !> sum m_p (mean normal stress of s_p) and sum m_p |s_p| (a scale), over all ranks.
+   function volumetric_sums(solver, comm) result(sums)
+      type(solver_t), intent(in) :: solver
+      type(MPI_Comm), intent(in) :: comm
+      real(rp) :: sums(2)
+      integer :: p
+      sums = 0.0_rp
+      do p = 1, solver%particles%count
+         sums(1) = sums(1) + solver%particles%mass(p) * sum(solver%particles%sbar(1:3, p)) / 3.0_rp
+         sums(2) = sums(2) + solver%particles%mass(p) * sum(abs(solver%particles%sbar(:, p)))
+      end do
+      call MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE_PRECISION, MPI_SUM, comm)
+   end function volumetric_sums
 
    !> Rows 1-4: sum m_p s_p per component; rows 5-6: sum m_p |s_p| (a scale); one column per material.
    function material_sums(solver, comm) result(sums)
