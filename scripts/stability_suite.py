@@ -58,6 +58,8 @@ def tank_cases(quick):
             overrides = base + [f"{head} {variable} = {value!r} /"]
             if variable == "cell_size" and value <= 0.1:
                 overrides[0] = "&run end_time = 0.1, output_interval = 0.1 /"     # 32 and 64 cpl: 0.1 s
+            if variable == "flip_fraction":
+                overrides[0] = "&run end_time = 3.0, output_interval = 3.0 /"     # the paper's 3 s
             cases.append((label, value, TANK, overrides))
     if not quick:      # a long run: 1e5 steps and more (10 s of the 45 degree tank)
         cases.append(("long run [s]", 10.0, TANK, ["&run end_time = 10.0, output_interval = 1.0 /",
