@@ -166,7 +166,7 @@ contains
 
       call particles_to_grid(solver%grid, solver%particles, solver%gravity)
       call sum_shared_nodes(solver%domain, solver%grid, solver%grid%accumulated)
-      call nodal_fields(solver, cell_lo, node_hi, local_nodes, node_mass, node_velocity)
+      call nodal_fields(solver, cell_lo, node_hi, local_nodes, node_mass, node_velocity, node_position)
 
       call file%create_group('grid', status)
       call file%create_group('grid/node', status)
@@ -176,7 +176,6 @@ contains
                             reshape(node_velocity, [size(node_velocity)]), status)
       ! a rotated grid is not a rectilinear mesh in the world: its node positions go into the file
       if (solver%grid%frame%rotated) then
-         call node_positions(solver, cell_lo, node_hi, local_nodes, node_position)
          call file%write_block('grid/node/position', [3_i8, nodes], [0_i8, offset], [3_i8, local_nodes], &
                                reshape(node_position, [size(node_position)]), status)
       end if
@@ -232,46 +231,23 @@ contains
       box_hi(dim + 1:) = 0
    end subroutine active_box
 
-   !> World positions of the nodes cell_lo..node_hi, x fastest.
-   subroutine node_positions(solver, cell_lo, node_hi, local_nodes, position)
-      type(solver_t), intent(in) :: solver
-      integer, intent(in) :: cell_lo(3), node_hi(3)
-      integer(i8), intent(in) :: local_nodes(3)
-      real(rp), allocatable, intent(out) :: position(:, :)
-      real(rp), allocatable :: grid_position(:, :)
-      integer :: i, j, l, n, dim
-      dim = solver%grid%dim
-      n = int(product(local_nodes))
-      allocate (position(3, max(n, 1)), grid_position(dim, max(n, 1)))
-      grid_position = 0.0_rp
-      if (n > 0) then
-         n = 0
-         do l = cell_lo(3), node_hi(3)
-            do j = cell_lo(2), node_hi(2)
-               do i = cell_lo(1), node_hi(1)
-                  n = n + 1
-                  grid_position(:, n) = solver%grid%origin(1:dim) + [i, j, l] * solver%grid%h
-               end do
-            end do
-         end do
-      end if
-      call solver%grid%frame%to_world_points(grid_position, position)
-   end subroutine node_positions
-
-   !> Mass and velocity P/m (0 on empty nodes) of the nodes cell_lo..node_hi, x fastest.
-   subroutine nodal_fields(solver, cell_lo, node_hi, local_nodes, mass, velocity)
+   !> Mass and velocity P/m (0 on empty nodes) of the nodes cell_lo..node_hi, x fastest, and with
+   !> `position` their world positions (a rotated grid writes them).
+   subroutine nodal_fields(solver, cell_lo, node_hi, local_nodes, mass, velocity, position)
       type(solver_t), intent(in) :: solver
       integer, intent(in) :: cell_lo(3), node_hi(3)
       integer(i8), intent(in) :: local_nodes(3)
       real(rp), allocatable, intent(out) :: mass(:), velocity(:, :)
-      real(rp), allocatable :: grid_velocity(:, :)
+      real(rp), allocatable, intent(out), optional :: position(:, :)
+      real(rp), allocatable :: grid_velocity(:, :), grid_position(:, :)
       integer :: i, j, l, n, node, dim, mom
       dim = solver%grid%dim
       mom = solver%grid%row_momentum
       n = int(product(local_nodes))
-      allocate (mass(max(n, 1)), velocity(3, max(n, 1)), grid_velocity(dim, max(n, 1)))
+      allocate (mass(max(n, 1)), velocity(3, max(n, 1)), grid_velocity(dim, max(n, 1)), grid_position(dim, max(n, 1)))
       mass = 0.0_rp
       grid_velocity = 0.0_rp
+      grid_position = 0.0_rp
       if (n > 0) then
          n = 0
          do l = cell_lo(3), node_hi(3)
@@ -282,11 +258,16 @@ contains
                   mass(n) = solver%grid%accumulated(row_mass, node)
                   if (mass(n) > solver%mass_tolerance) &
                      grid_velocity(:, n) = solver%grid%accumulated(mom:mom + dim - 1, node) / mass(n)
+                  grid_position(:, n) = solver%grid%origin(1:dim) + [i, j, l] * solver%grid%h
                end do
             end do
          end do
       end if
       call solver%grid%frame%to_world_vectors(grid_velocity, velocity)
+      if (present(position)) then
+         allocate (position(3, max(n, 1)))
+         call solver%grid%frame%to_world_points(grid_position, position)
+      end if
    end subroutine nodal_fields
 
    !> Volume-weighted cell averages of material m over the local_cells from cell_lo (x fastest): density
