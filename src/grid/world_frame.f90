@@ -57,12 +57,10 @@ contains
       class(frame_t), intent(in) :: self
       real(rp), intent(in) :: x(:)
       real(rp) :: g(size(x))
-      integer :: d
-      d = size(x)
       if (.not. self%rotated) then
          g = x
       else
-         g = self%pivot(1:d) + matmul(transpose(self%to_world(1:d, 1:d)), x - self%pivot(1:d))
+         g = self%pivot(1:size(x)) + self%grid_vector(x - self%pivot(1:size(x)))
       end if
    end function frame_grid_point
 
@@ -85,12 +83,10 @@ contains
       class(frame_t), intent(in) :: self
       real(rp), intent(in) :: x(:)
       real(rp) :: w(size(x))
-      integer :: d
-      d = size(x)
       if (.not. self%rotated) then
          w = x
       else
-         w = self%pivot(1:d) + matmul(self%to_world(1:d, 1:d), x - self%pivot(1:d))
+         w = self%pivot(1:size(x)) + self%world_vector(x - self%pivot(1:size(x)))
       end if
    end function frame_world_point
 

@@ -1,6 +1,6 @@
 !> Copy a scene from the rank that read the file to every rank.
 module scene_broadcast
-   use mpi_f08, only: MPI_Comm, MPI_Bcast, MPI_CHARACTER, MPI_INTEGER
+   use mpi_f08, only: MPI_Comm, MPI_Bcast, MPI_Comm_rank, MPI_CHARACTER, MPI_INTEGER
    use scene_description, only: scene_t
    implicit none
    private
@@ -12,36 +12,16 @@ module scene_broadcast
 
 contains
 
-   !> Copy `root`'s scene to every rank: array sizes first, then the contents. Collective over `comm`.
-   !> Every component of the scene types has a fixed size, so each part travels as its bytes
-   !> (all ranks run the same executable); an allocatable or pointer component added to one of
+   !> Copy `root`'s scene to every rank: array sizes first, then the contents in one message. Collective
+   !> over `comm`. Every component of the scene types has a fixed size, so each part travels as its
+   !> bytes (all ranks run the same executable); an allocatable or pointer component added to one of
    !> these types would need its own broadcast here.
    subroutine broadcast_scene(scene, comm, root)
       type(scene_t), intent(inout) :: scene
       type(MPI_Comm), intent(in) :: comm
       integer, intent(in) :: root
       character(len=1), allocatable :: bytes(:)
-      integer :: counts(4), rank_count(4)
-
-      call resize(bytes, size(transfer(scene%source_file, byte_mold)))
-      bytes(:) = transfer(scene%source_file, byte_mold)
-      call broadcast_bytes(bytes, comm, root)
-      scene%source_file = transfer(bytes, scene%source_file)
-
-      call resize(bytes, size(transfer(scene%run, byte_mold)))
-      bytes(:) = transfer(scene%run, byte_mold)
-      call broadcast_bytes(bytes, comm, root)
-      scene%run = transfer(bytes, scene%run)
-
-      call resize(bytes, size(transfer(scene%grid, byte_mold)))
-      bytes(:) = transfer(scene%grid, byte_mold)
-      call broadcast_bytes(bytes, comm, root)
-      scene%grid = transfer(bytes, scene%grid)
-
-      call resize(bytes, size(transfer(scene%gravity, byte_mold)))
-      bytes(:) = transfer(scene%gravity, byte_mold)
-      call broadcast_bytes(bytes, comm, root)
-      scene%gravity = transfer(bytes, scene%gravity, size(scene%gravity))
+      integer :: counts(4), rank_count(4), rank, n, at
 
       ! -1 stands for "not allocated".
       counts = -1
@@ -62,30 +42,46 @@ contains
          if (counts(4) >= 0) allocate (scene%inlets(counts(4)))
       end if
 
-      if (counts(1) > 0) then
-         call resize(bytes, size(transfer(scene%materials, byte_mold)))
-         bytes(:) = transfer(scene%materials, byte_mold)
-         call broadcast_bytes(bytes, comm, root)
-         scene%materials(:) = transfer(bytes, scene%materials, counts(1))
+      ! the parts one after the other, packed on root and unpacked in the same order elsewhere
+      call MPI_Comm_rank(comm, rank)
+      n = 0
+      if (rank == root) then
+         bytes = [transfer(scene%source_file, byte_mold), transfer(scene%run, byte_mold), &
+                  transfer(scene%grid, byte_mold), transfer(scene%gravity, byte_mold)]
+         if (counts(1) > 0) bytes = [bytes, transfer(scene%materials, byte_mold)]
+         if (counts(2) > 0) bytes = [bytes, transfer(scene%bodies, byte_mold)]
+         if (counts(3) > 0) bytes = [bytes, transfer(scene%walls, byte_mold)]
+         if (counts(4) > 0) bytes = [bytes, transfer(scene%inlets, byte_mold)]
+         n = size(bytes)
       end if
-      if (counts(2) > 0) then
-         call resize(bytes, size(transfer(scene%bodies, byte_mold)))
-         bytes(:) = transfer(scene%bodies, byte_mold)
-         call broadcast_bytes(bytes, comm, root)
-         scene%bodies(:) = transfer(bytes, scene%bodies, counts(2))
-      end if
-      if (counts(3) > 0) then
-         call resize(bytes, size(transfer(scene%walls, byte_mold)))
-         bytes(:) = transfer(scene%walls, byte_mold)
-         call broadcast_bytes(bytes, comm, root)
-         scene%walls(:) = transfer(bytes, scene%walls, counts(3))
-      end if
-      if (counts(4) > 0) then
-         call resize(bytes, size(transfer(scene%inlets, byte_mold)))
-         bytes(:) = transfer(scene%inlets, byte_mold)
-         call broadcast_bytes(bytes, comm, root)
-         scene%inlets(:) = transfer(bytes, scene%inlets, counts(4))
-      end if
+      call MPI_Bcast(n, 1, MPI_INTEGER, root, comm)
+      if (rank /= root) call resize(bytes, n)
+      call MPI_Bcast(bytes, n, MPI_CHARACTER, root, comm)
+      if (rank == root) return
+
+      at = 1
+      scene%source_file = transfer(next_bytes(size(transfer(scene%source_file, byte_mold))), scene%source_file)
+      scene%run = transfer(next_bytes(size(transfer(scene%run, byte_mold))), scene%run)
+      scene%grid = transfer(next_bytes(size(transfer(scene%grid, byte_mold))), scene%grid)
+      scene%gravity = transfer(next_bytes(size(transfer(scene%gravity, byte_mold))), scene%gravity, size(scene%gravity))
+      if (counts(1) > 0) scene%materials(:) = transfer(next_bytes(counts(1) * size(transfer(scene%materials(1), &
+                                                       byte_mold))), scene%materials, counts(1))
+      if (counts(2) > 0) scene%bodies(:) = transfer(next_bytes(counts(2) * size(transfer(scene%bodies(1), byte_mold))), &
+                                                    scene%bodies, counts(2))
+      if (counts(3) > 0) scene%walls(:) = transfer(next_bytes(counts(3) * size(transfer(scene%walls(1), byte_mold))), &
+                                                   scene%walls, counts(3))
+      if (counts(4) > 0) scene%inlets(:) = transfer(next_bytes(counts(4) * size(transfer(scene%inlets(1), byte_mold))), &
+                                                    scene%inlets, counts(4))
+
+   contains
+
+      !> The next `length` bytes of the buffer.
+      function next_bytes(length) result(part)
+         integer, intent(in) :: length
+         character(len=1) :: part(length)
+         part = bytes(at:at + length - 1)
+         at = at + length
+      end function next_bytes
    end subroutine broadcast_scene
 
    !> Allocate `bytes` with `n` elements (assigning to an unallocated array first makes gfortran 12
@@ -99,11 +95,4 @@ contains
       end if
       allocate (bytes(n))
    end subroutine resize
-
-   subroutine broadcast_bytes(bytes, comm, root)
-      character(len=1), intent(inout) :: bytes(:)
-      type(MPI_Comm), intent(in) :: comm
-      integer, intent(in) :: root
-      call MPI_Bcast(bytes, size(bytes), MPI_CHARACTER, root, comm)
-   end subroutine broadcast_bytes
 end module scene_broadcast

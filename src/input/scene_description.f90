@@ -58,7 +58,7 @@ module scene_description
    !> (unbounded by default). The solver turns the `&box_walls` sides into walls of this kind.
    type, public :: wall_spec_t
       real(rp) :: point(3) = 0.0_rp           !< a point of the wall [m]
-      real(rp) :: normal(3) = 0.0_rp          !< normal pointing into the fluid (made unit when resolved)
+      real(rp) :: normal(3) = 0.0_rp          !< normal pointing into the fluid, any length (made unit by make_wall)
       real(rp) :: lower(3) = -huge(1.0_rp)    !< extent of the wall: lower corner of its bounding box [m]
       real(rp) :: upper(3) = huge(1.0_rp)     !< upper corner [m]
       character(len=name_len) :: condition = wall_slip
@@ -80,6 +80,8 @@ module scene_description
       integer :: particles_per_cell = 2       !< particles per cell per direction
       logical :: hydrostatic = .false.        !< new particles carry the hydrostatic pressure below the stream top
    end type inlet_spec_t
+
+   public :: opening_tangent, opening_far_end
 
    !> `&material`: one constitutive model and its parameters.
    type, public :: material_spec_t
@@ -121,4 +123,24 @@ module scene_description
       type(wall_spec_t), allocatable :: walls(:)      !< `&wall` groups (the `&box_walls` sides are in grid)
       type(inlet_spec_t), allocatable :: inlets(:)
    end type scene_t
+
+contains
+
+   !> The in-plane direction along which an inlet's `height` runs: t = (-d_y, d_x, 0), d the unit
+   !> flow direction.
+   pure function opening_tangent(inlet) result(tangent)
+      type(inlet_spec_t), intent(in) :: inlet
+      real(rp) :: tangent(3), d(2)
+      d = inlet%direction(1:2) / norm2(inlet%direction(1:2))
+      tangent = [-d(2), d(1), 0.0_rp]
+   end function opening_tangent
+
+   !> The corner of an inlet's opening opposite `point`: point + height t (+ width e_z in 3-D).
+   pure function opening_far_end(inlet, dim) result(far_end)
+      type(inlet_spec_t), intent(in) :: inlet
+      integer, intent(in) :: dim
+      real(rp) :: far_end(3)
+      far_end = inlet%point + inlet%height * opening_tangent(inlet)
+      if (dim == 3) far_end(3) = far_end(3) + inlet%width
+   end function opening_far_end
 end module scene_description

@@ -6,7 +6,7 @@ module scene_validation
    use kinds, only: rp, i8, name_len
    use error_status, only: status_t
    use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
-                                inlet_spec_t, wall_none, wall_slip, wall_no_slip, model_newtonian_fluid, &
+                                inlet_spec_t, opening_far_end, wall_none, wall_slip, wall_no_slip, model_newtonian_fluid, &
                                 model_linear_elastic
    use input_text, only: int_text, real_text, quoted_list, group_context, ordinal
    implicit none
@@ -105,7 +105,7 @@ contains
    !> scene that `validate_scene` accepted.
    subroutine resolve_scene(scene)
       type(scene_t), intent(inout) :: scene
-      integer :: k, b, w, i
+      integer :: k, b, i
 
       associate (run => scene%run, grid => scene%grid)
          ! Validated >= 0, so not > 0 means 0.
@@ -120,12 +120,7 @@ contains
       do b = 1, size(scene%bodies)
          scene%bodies(b)%material_index = find_material(scene%materials, scene%bodies(b)%material)
       end do
-      if (.not. allocated(scene%walls)) allocate (scene%walls(0))
-      do w = 1, size(scene%walls)
-         associate (normal => scene%walls(w)%normal(1:scene%grid%dim))
-            normal = normal / norm2(normal)
-         end associate
-      end do
+      if (.not. allocated(scene%walls)) allocate (scene%walls(0))     ! (wall normals are made unit where walls are built)
       if (.not. allocated(scene%inlets)) allocate (scene%inlets(0))
       do i = 1, size(scene%inlets)
          associate (inlet => scene%inlets(i))
@@ -442,7 +437,7 @@ contains
       character(len=*), intent(in) :: path
       type(status_t), intent(inout) :: status
       character(len=:), allocatable :: where
-      real(rp) :: direction(3), tangent(3), far_end(3), tolerance
+      real(rp) :: far_end(3), tolerance
       integer :: k, m, dim
 
       dim = grid%dim
@@ -480,11 +475,7 @@ contains
          return
       end if
       ! both ends of the opening must lie in the scene box
-      direction = 0.0_rp
-      direction(1:dim) = inlet%direction(1:dim) / norm2(inlet%direction(1:dim))
-      tangent = [-direction(2), direction(1), 0.0_rp]
-      far_end = inlet%point + inlet%height * tangent
-      if (dim == 3) far_end(3) = far_end(3) + inlet%width
+      far_end = opening_far_end(inlet, dim)
       tolerance = inside_tolerance * grid%cell_size
       do k = 1, dim
          if (inlet%point(k) < grid%origin(k) - tolerance .or. &

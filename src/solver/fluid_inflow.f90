@@ -13,7 +13,7 @@
 !> first_id + (inlet - 1) 2^40 + (k - 1) n_layer + index in the layer, independent of the rank count.
 module fluid_inflow
    use kinds, only: rp, i8
-   use scene_description, only: scene_t, inlet_spec_t
+   use scene_description, only: scene_t, inlet_spec_t, opening_tangent, opening_far_end
    use tensor_layout, only: n_components
    use background_grid, only: grid_t
    use domain_decomposition, only: domain_t
@@ -68,7 +68,7 @@ contains
       do i = 1, size(inlets)
          associate (inlet => inlets(i), spec => scene%inlets(i))
             inlet%spec = spec
-            inlet%tangent = [-spec%direction(2), spec%direction(1), 0.0_rp]
+            inlet%tangent = opening_tangent(spec)
             inlet%spacing = scene%grid%cell_size / spec%particles_per_cell
             inlet%across = 1
             inlet%across(1) = max(1, nint(spec%height / inlet%spacing))
@@ -86,8 +86,7 @@ contains
             inlet%gravity_norm = norm2(scene%gravity(1:dim))
             if (inlet%gravity_norm > 0.0_rp) inlet%up(1:dim) = -scene%gravity(1:dim) / inlet%gravity_norm
 
-            far_end = spec%point + spec%height * inlet%tangent
-            if (dim == 3) far_end(3) = far_end(3) + spec%width
+            far_end = opening_far_end(spec, dim)
             inlet%stream_top = max(dot_product(inlet%up, spec%point), dot_product(inlet%up, far_end))
             lower = min(spec%point, far_end)
             upper = max(spec%point, far_end)

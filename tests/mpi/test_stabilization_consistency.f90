@@ -111,7 +111,6 @@ contains
       real(rp), allocatable, intent(inout) :: field(:, :)
       type(solver_t), target :: solver
       type(status_t) :: status
-      type(stage_context_t) :: context
       integer :: p, n_total
       real(rp) :: count_real
 
@@ -122,12 +121,7 @@ contains
                                                 solver%grid%cell_of_position(solver%particles%x(:, p)), pattern, &
                                                 solver%particles%n_sigma)
       end do
-      context%domain => solver%domain
-      context%grid => solver%grid
-      context%first = solver%particles%material_first(1)
-      context%last = solver%particles%material_last(1)
-      call solver%schemes(1)%scheme%prepare(context, solver%particles)
-      call solver%schemes(1)%scheme%filter_stress(context, solver%particles)
+      call smooth_stress(solver, 1)
 
       count_real = real(solver%particles%count, rp)
       call MPI_Allreduce(MPI_IN_PLACE, count_real, 1, MPI_DOUBLE_PRECISION, MPI_SUM, comm)
@@ -148,7 +142,6 @@ contains
       type(solver_t), target :: solver
       type(scene_t) :: scene
       type(status_t) :: status
-      type(stage_context_t) :: context
       real(rp) :: before(6, 2), after(6, 2), scale(2)
       integer :: m, p
       scene = block_scene(2, 'FOAL1')
@@ -163,14 +156,9 @@ contains
          solver%particles%sbar(:, p) = value_of(solver%particles%id(p) + 1000 * solver%particles%material(p), &
                                                 [0, 0, 0], random_field, 4)
       end do
-      context%domain => solver%domain
-      context%grid => solver%grid
       before = material_sums(solver, comm)
       do m = 1, 2
-         context%first = solver%particles%material_first(m)
-         context%last = solver%particles%material_last(m)
-         call solver%schemes(m)%scheme%prepare(context, solver%particles)
-         call solver%schemes(m)%scheme%filter_stress(context, solver%particles)
+         call smooth_stress(solver, m)
       end do
       after = material_sums(solver, comm)
       do m = 1, 2
@@ -188,7 +176,6 @@ contains
       type(solver_t), target :: solver
       type(scene_t) :: scene
       type(status_t) :: status
-      type(stage_context_t) :: context
       real(rp), allocatable :: deviator(:, :)
       real(rp) :: before(2), after(2), mean, spread
       integer :: p, c, q
@@ -203,12 +190,7 @@ contains
          deviator(:, p) = solver%particles%sbar(:, p) - [mean, mean, mean, 0.0_rp]
       end do
       before = volumetric_sums(solver, comm)
-      context%domain => solver%domain
-      context%grid => solver%grid
-      context%first = solver%particles%material_first(1)
-      context%last = solver%particles%material_last(1)
-      call solver%schemes(1)%scheme%prepare(context, solver%particles)
-      call solver%schemes(1)%scheme%filter_stress(context, solver%particles)
+      call smooth_stress(solver, 1)
       after = volumetric_sums(solver, comm)
       call assertEqual(before(1), after(1), 1.0e-13_rp * before(2), 'sum m_p mean stress kept')
       spread = 0.0_rp
@@ -239,6 +221,19 @@ contains
       end do
       call MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE_PRECISION, MPI_SUM, comm)
    end function volumetric_sums
+
+   !> Filter part B of material m's scheme on the solver's current state (its cells binned first).
+   subroutine smooth_stress(solver, m)
+      type(solver_t), intent(inout), target :: solver
+      integer, intent(in) :: m
+      type(stage_context_t) :: context
+      context%domain => solver%domain
+      context%grid => solver%grid
+      context%first = solver%particles%material_first(m)
+      context%last = solver%particles%material_last(m)
+      call solver%schemes(m)%scheme%prepare(context, solver%particles)
+      call solver%schemes(m)%scheme%filter_stress(context, solver%particles)
+   end subroutine smooth_stress
 
    !> Rows 1-4: sum m_p s_p per component; rows 5-6: sum m_p |s_p| (a scale); one column per material.
    function material_sums(solver, comm) result(sums)
