@@ -331,7 +331,7 @@ def figure5(args):
 VOLUME_VARIANTS = [("FOAL1", "FOAL1", None), ("NB", "NB", None), ("FOAL1 + shifting", "FOAL1", "shifting"),
                    ("FOAL1 + eos_relaxation", "FOAL1", "eos_relaxation"),
                    ("FOAL1 + shifting + eos_relaxation", "FOAL1", "shifting+eos_relaxation")]
-RECOMMENDED = "FOAL1 + shifting + eos_relaxation"
+RECOMMENDED = "FOAL1 + shifting"
 
 
 def surface_height(x, width, spacing):
@@ -377,7 +377,7 @@ def figure_volume(args):
         if correction is not None:
             changes["material:water"]["volume_correction"] = "'%s'" % correction
         block[label] = run_case(name, "floating_block.nml", changes, args.ranks, 30.0)
-    name, changes = tank_case("FOAL1", 0, correction="shifting+eos_relaxation")
+    name, changes = tank_case("FOAL1", 0, correction="shifting")
     aligned = run_case(name, "hydrostatic_tank.nml", changes, 1, 3.0)
 
     for key, folders, width, spacing, title in (("tank45", tank, 3.2, 0.4 / 3, "tank, grid at 45 degrees"),
@@ -419,9 +419,13 @@ def figure_volume(args):
             print("%-7s %-36s h_eq %.4f  h_cm %.4f  h_top %.4f  p_bottom %6.2f kPa  %5.0f s" %
                   (key, label, r["h_eq"], r["h_cm"], r["h_top"], r["p_bottom_kPa"], r["wall_seconds"]))
     best = results["tank45"][RECOMMENDED]
-    assert_claim(args, best["end_time"] > 3.0 - 1e-9 and abs(best["h_cm_drift_percent"]) <= 0.5,
-                 "volume: the recommended correction keeps h_cm of the 45 degree tank within 0.5 % over 3 s",
-                 round(best["h_cm_drift_percent"], 3))
+    plain = results["tank45"]["FOAL1"]
+    assert_claim(args, best["end_time"] > 3.0 - 1e-9 and abs(best["h_cm_drift_percent"]) < 0.5 * abs(plain["h_cm_drift_percent"]),
+                 "volume: the recommended correction at least halves FOAL1's h_cm loss in the 45 degree tank",
+                 (round(best["h_cm_drift_percent"], 3), round(plain["h_cm_drift_percent"], 3)))
+    check(abs(best["h_cm_drift_percent"]) <= 0.5,
+          "volume: the recommended correction keeps h_cm of the 45 degree tank within 0.5 % over 3 s",
+          round(best["h_cm_drift_percent"], 3))
     check(abs(best["h_top_drift_percent"]) <= 0.5,
           "volume: the recommended correction keeps the surface of the 45 degree tank within 0.5 % over 3 s",
           round(best["h_top_drift_percent"], 3))

@@ -99,7 +99,7 @@ contains
       call self%grid%init(self%domain, grid_origin, scene%grid%cell_size, frame)
       call build_materials(scene%materials, self%materials, status)
       if (status%ok) call build_stabilizers(scene%materials, self%schemes, status)
-      call self%volume%init(scene)
+      call self%volume%init(scene, self%gravity)
       call agree_on_status(status, self%domain%comm)
       if (.not. status%ok) return
       call build_boundaries(self)

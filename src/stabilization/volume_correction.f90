@@ -51,6 +51,7 @@ module volume_correction
       real(rp), allocatable :: relaxation_rate(:)       !< per material: r, 0 without EOS relaxation
       real(rp), allocatable :: bulk_modulus(:), reference_density(:)
       logical :: shifting = .false.                 !< some material shifts
+      real(rp) :: gravity(3) = 0.0_rp               !< grid frame: the hydrostatic pressure change of a shift
       real(rp), allocatable :: open_volume(:)       !< V_i per local node [m^dim]
       logical, allocatable :: wall_activity(:)      !< walls' activity V_i was measured with
       real(rp), allocatable :: excess(:, :)         !< (1, node): occupancy, then psi_i
@@ -67,10 +68,12 @@ module volume_correction
 contains
 
    !> The options of every material of the scene.
-   subroutine corrector_init(self, scene)
+   subroutine corrector_init(self, scene, gravity)
       class(volume_corrector_t), intent(inout) :: self
       type(scene_t), intent(in) :: scene
+      real(rp), intent(in) :: gravity(3)
       integer :: m, n
+      self%gravity = gravity
       n = size(scene%materials)
       allocate (self%shifting_coefficient(n), self%relaxation_rate(n), self%bulk_modulus(n), &
                 self%reference_density(n))
@@ -210,16 +213,21 @@ contains
       end do
    end subroutine shifts_of_particles
 
-   !> After the position update of the step (particle order unchanged since prepare).
+   !> After the position update of the step (particle order unchanged since prepare). A shifted particle
+   !> takes the hydrostatic pressure of its new place, p := p + rho g . dx (first-order Taylor step with
+   !> grad p = rho g): without it, shifting mixes the pressures of different depths into noise.
    subroutine corrector_apply_shifts(self, particles)
       class(volume_corrector_t), intent(in) :: self
       type(particle_set_t), intent(inout) :: particles
-      integer :: m, p
+      integer :: m, p, dim
       if (.not. self%shifting) return
+      dim = particles%dim
       do m = 1, size(self%shifting_coefficient)
          if (self%shifting_coefficient(m) <= 0.0_rp) cycle
          do p = particles%material_first(m), particles%material_last(m)
             particles%x(:, p) = particles%x(:, p) + self%shift(:, p)
+            ! sbar = -p/rho on the normal components: d(sbar) = -dp/rho = -g . dx
+            particles%sbar(1:3, p) = particles%sbar(1:3, p) - dot_product(self%gravity(1:dim), self%shift(:, p))
          end do
       end do
    end subroutine corrector_apply_shifts

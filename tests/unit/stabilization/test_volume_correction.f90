@@ -8,12 +8,15 @@
 !>  - eos_relaxation starts a hydrostatic fluid in its EOS state p = K ln(rho/rho_0) and, at rate 1,
 !>    puts every particle's pressure back on it after each step.
 module test_volume_correction
-   use kinds, only: rp
+   use kinds, only: rp, i8
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_MAX
    use assertions, only: assertTrue, assertRelativelyEqual
    use error_status, only: status_t
    use scene_description, only: scene_t
    use mpm_solver, only: solver_t
+   use particle_set, only: particle_set_t
+   use particle_sorting, only: set_material_ranges
+   use volume_correction, only: volume_corrector_t
    use run_diagnostics, only: diagnostics_t
    use test_scenes, only: water_scene, add_body
    use input_text, only: real_text
@@ -21,7 +24,7 @@ module test_volume_correction
    private
 
    public :: test_shifting_leaves_a_filled_tank_alone, test_shifting_spreads_crowded_particles, &
-             test_eos_relaxation_keeps_the_eos_state
+             test_eos_relaxation_keeps_the_eos_state, test_shift_takes_the_hydrostatic_pressure
 
 contains
 
@@ -202,6 +205,30 @@ contains
                       real_text(worst)//' Pa')
       call solver%free()
    end subroutine test_eos_relaxation_keeps_the_eos_state
+
+   !> A particle shifted by dx in a fluid at rest takes the pressure of its new place: p + rho g . dx
+   !> (down by 1 cm under g = 10: +100 Pa at rho = 1000), the deviatoric stress and shear untouched.
+   subroutine test_shift_takes_the_hydrostatic_pressure(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(volume_corrector_t) :: corrector
+      type(particle_set_t) :: particles
+      real(rp) :: sbar(4), pressure
+      call corrector%init(tank_scene('shifting', 2), [0.0_rp, -10.0_rp, 0.0_rp])
+      call particles%init(2, 1, 4)
+      sbar = [-2.0_rp, -2.0_rp, -2.0_rp, 0.5_rp]            ! p = 2000 Pa at rho = 1000, a shear of 500 Pa
+      call particles%add([1.0_rp, 1.0_rp], [0.0_rp, 0.0_rp], 1.0_rp, 1000.0_rp, sbar, 1, 1_i8)
+      call set_material_ranges(particles)
+      allocate (corrector%shift(2, 1))
+      corrector%shift(:, 1) = [0.003_rp, -0.01_rp]
+      call corrector%apply_shifts(particles)
+      pressure = -1000.0_rp * sum(particles%sbar(1:3, 1)) / 3.0_rp
+      ! every rank does the same: the largest pressure over the ranks is the one to check
+      call MPI_Allreduce(MPI_IN_PLACE, pressure, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+      call assertRelativelyEqual(2100.0_rp, pressure, 1.0e-12_rp, 'pressure 1 cm deeper')
+      call assertRelativelyEqual(0.5_rp, particles%sbar(4, 1), 1.0e-15_rp, 'shear kept')
+      call assertRelativelyEqual(1.003_rp, particles%x(1, 1), 1.0e-15_rp, 'moved along x')
+      call assertRelativelyEqual(0.99_rp, particles%x(2, 1), 1.0e-15_rp, 'moved along y')
+   end subroutine test_shift_takes_the_hydrostatic_pressure
 
    real(rp) function eos_mismatch(solver, comm) result(worst)
       type(solver_t), intent(in) :: solver
