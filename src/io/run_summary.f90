@@ -3,10 +3,13 @@
 !>   wall_seconds, steps, particle_steps, particle_steps_per_second_per_core, ranks,
 !>   peak_memory_bytes (largest rank), peak_memory_bytes_total (all ranks), outcome
 !> Steps and particle-steps count this invocation only (a restarted run reports its continuation).
+!> `timing.csv` beside it: the time loop's wall time per phase (phase_timers), one row per phase:
+!>   phase, seconds_max (the slowest rank's), seconds_mean (over the ranks), share (of the mean loop time)
+!> and a last row `total`.
 module run_summary
    use kinds, only: rp, i8
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_Comm_rank, MPI_Comm_size, MPI_IN_PLACE, MPI_INTEGER8, &
-                      MPI_SUM, MPI_MAX
+                      MPI_DOUBLE_PRECISION, MPI_SUM, MPI_MAX
    use error_status, only: status_t
    use process_memory, only: peak_resident_bytes
    use input_text, only: int_text, real_text
@@ -15,9 +18,9 @@ module run_summary
    implicit none
    private
 
-   character(len=*), parameter, public :: run_summary_file = 'run_summary.csv'
+   character(len=*), parameter, public :: run_summary_file = 'run_summary.csv', timing_file = 'timing.csv'
 
-   public :: write_run_summary
+   public :: write_run_summary, write_timing
 
 contains
 
@@ -59,4 +62,40 @@ contains
       if (.not. rename_path(dir//'/'//run_summary_file//temporary_suffix, dir//'/'//run_summary_file)) &
          call status%fail('cannot rename '//dir//'/'//run_summary_file//temporary_suffix)
    end subroutine write_run_summary
+
+   !> Collective over `comm`: rank 0 writes <dir>/timing.csv (replacing it) from every rank's `seconds`
+   !> of the phases `names`.
+   subroutine write_timing(dir, comm, seconds, names, status)
+      character(len=*), intent(in) :: dir
+      type(MPI_Comm), intent(in) :: comm
+      real(rp), intent(in) :: seconds(:)
+      character(len=*), intent(in) :: names(:)
+      type(status_t), intent(inout) :: status
+      real(rp) :: largest(size(seconds)), mean(size(seconds)), total
+      integer :: rank, ranks, unit, ios, k
+      character(len=256) :: message
+
+      call MPI_Comm_rank(comm, rank)
+      call MPI_Comm_size(comm, ranks)
+      call MPI_Allreduce(seconds, largest, size(seconds), MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+      call MPI_Allreduce(seconds, mean, size(seconds), MPI_DOUBLE_PRECISION, MPI_SUM, comm)
+      if (rank /= 0) return
+      mean = mean / ranks
+      total = sum(mean)
+      open (newunit=unit, file=dir//'/'//timing_file//temporary_suffix, status='replace', action='write', &
+            iostat=ios, iomsg=message)
+      if (ios /= 0) then
+         call status%fail('cannot write '//dir//'/'//timing_file//': '//trim(message))
+         return
+      end if
+      write (unit, '(a)') 'phase,seconds_max,seconds_mean,share'
+      do k = 1, size(seconds)
+         write (unit, '(a)') trim(names(k))//','//real_text(largest(k))//','//real_text(mean(k))//','// &
+            real_text(merge(mean(k) / total, 0.0_rp, total > 0.0_rp))
+      end do
+      write (unit, '(a)') 'total,'//real_text(sum(largest))//','//real_text(total)//',1'
+      close (unit)
+      if (.not. rename_path(dir//'/'//timing_file//temporary_suffix, dir//'/'//timing_file)) &
+         call status%fail('cannot rename '//dir//'/'//timing_file//temporary_suffix)
+   end subroutine write_timing
 end module run_summary

@@ -34,6 +34,9 @@ module mpm_solver
    use grid_transfer, only: particles_to_grid, update_velocity_and_remap, grid_to_particles
    use run_diagnostics, only: diagnostics_t, compute_diagnostics
    use status_broadcast, only: agree_on_status
+   use phase_timers, only: phase_timers_t, phase_particles_to_grid, phase_grid_update, phase_walls, &
+                           phase_stabilization, phase_grid_to_particles, phase_constitutive, phase_inflow, &
+                           phase_halo, phase_migration, phase_sort, phase_time_step, phase_other
    implicit none
    private
 
@@ -58,6 +61,7 @@ module mpm_solver
       real(rp) :: mass_tolerance = 0.0_rp       !< nodes lighter than this carry no velocity
       logical :: musl = .false.
       real(rp), allocatable :: remapped_momentum(:, :)
+      type(phase_timers_t) :: timers            !< wall time per phase (the time loop adds its own phases)
    contains
       procedure :: init => solver_init
       procedure :: advance => solver_advance
@@ -184,20 +188,26 @@ contains
       type(stage_context_t) :: context
 
       dt = self%dt
+      call self%timers%switch_to(phase_walls)
       call set_wall_activity(self%walls, self%time)
       context%domain => self%domain
       context%grid => self%grid
       context%dt = dt
+      call self%timers%switch_to(phase_particles_to_grid)
       call particles_to_grid(self%grid, self%particles, self%gravity)
+      call self%timers%switch_to(phase_halo)
       call sum_shared_nodes(self%domain, self%grid, self%grid%accumulated)
+      call self%timers%switch_to(phase_grid_update)
       call update_nodes(self, dt)
 
+      call self%timers%switch_to(phase_stabilization)
       do m = 1, size(self%schemes)
          if (.not. allocated(self%schemes(m)%scheme)) cycle
          call set_slice(m)
          call self%schemes(m)%scheme%prepare(context, self%particles)
       end do
 
+      call self%timers%switch_to(phase_grid_to_particles)
       associate (run => self%run)
          if (self%musl) then
             call remap_velocities(self)
@@ -210,11 +220,13 @@ contains
          end if
       end associate
 
+      call self%timers%switch_to(phase_stabilization)
       do m = 1, size(self%schemes)
          if (.not. allocated(self%schemes(m)%scheme)) cycle
          call set_slice(m)
          call self%schemes(m)%scheme%filter_strain_rate(context, self%particles)
       end do
+      call self%timers%switch_to(phase_constitutive)
       do m = 1, size(self%materials)
          first = self%particles%material_first(m)
          last = self%particles%material_last(m)
@@ -223,18 +235,23 @@ contains
                                                    self%particles%spin(:, first:last), &
                                                    self%particles%density(first:last), self%particles%sbar(:, first:last))
       end do
+      call self%timers%switch_to(phase_stabilization)
       do m = 1, size(self%schemes)
          if (.not. allocated(self%schemes(m)%scheme)) cycle
          call set_slice(m)
          call self%schemes(m)%scheme%filter_stress(context, self%particles)
       end do
 
+      call self%timers%switch_to(phase_walls)
       call keep_particles_inside(self%walls, self%grid, self%particles, self%wall_corrections)
+      call self%timers%switch_to(phase_inflow)
       created = 0
       do i = 1, size(self%inlets)
          created = created + self%inlets(i)%inject(self%time, self%time + dt, self%grid, self%domain, self%particles)
       end do
+      call self%timers%switch_to(phase_migration)
       call migrate_particles(self%domain, self%grid, self%particles, self%lost_particles, arrived)
+      call self%timers%switch_to(phase_sort)
       ! arrivals and new particles are appended at the end: re-sort so materials stay contiguous;
       ! otherwise re-sort now and then for memory locality (removals keep the grouping of the rest)
       if (arrived > 0 .or. created > 0 .or. mod(self%step + 1, int(sort_interval, i8)) == 0) then
@@ -245,7 +262,9 @@ contains
 
       self%time = self%time + dt
       self%step = self%step + 1
+      call self%timers%switch_to(phase_time_step)
       self%dt = self%stable_time_step()
+      call self%timers%switch_to(phase_other)
 
    contains
 
@@ -276,7 +295,9 @@ contains
                v(:, i) = 0.0_rp
             end if
          end do
+         call self%timers%switch_to(phase_walls)
          call apply_wall_constraints(self%walls, dim, v)
+         call self%timers%switch_to(phase_grid_update)
          dv = v - dv
       end associate
    end subroutine update_nodes
@@ -287,7 +308,9 @@ contains
       integer :: i
       real(rp) :: m
       call update_velocity_and_remap(self%grid, self%particles, self%run%flip_fraction, self%remapped_momentum)
+      call self%timers%switch_to(phase_halo)
       call sum_shared_nodes(self%domain, self%grid, self%remapped_momentum)
+      call self%timers%switch_to(phase_grid_to_particles)
       do i = 1, self%grid%node_count
          m = self%grid%accumulated(row_mass, i)
          if (m > self%mass_tolerance) then
@@ -296,7 +319,9 @@ contains
             self%remapped_momentum(:, i) = 0.0_rp
          end if
       end do
+      call self%timers%switch_to(phase_walls)
       call apply_wall_constraints(self%walls, self%grid%dim, self%remapped_momentum)
+      call self%timers%switch_to(phase_grid_to_particles)
    end subroutine remap_velocities
 
    !> dt = CFL h / (sqrt(dim) max_p (c_p + |v_p|)), limited by the viscous step CFL rho h^2 / (2 dim mu)
