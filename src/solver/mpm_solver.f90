@@ -186,6 +186,7 @@ contains
       integer :: m, first, last, arrived, created, i
       real(rp) :: dt
       type(stage_context_t) :: context
+      logical :: smoothed(size(self%schemes)), spin_needed
 
       dt = self%dt
       call self%timers%switch_to(phase_walls)
@@ -193,6 +194,18 @@ contains
       context%domain => self%domain
       context%grid => self%grid
       context%dt = dt
+      ! a scheme of a material no body or opened inlet supplies has no particles on any rank: skip it (its
+      ! halo exchange and cell scans); a supplied one runs on every rank, with or without particles there
+      do m = 1, size(self%schemes)
+         smoothed(m) = allocated(self%schemes(m)%scheme)
+         if (smoothed(m)) smoothed(m) = material_supplied(self, m)
+      end do
+      ! the spin only for the solids (local: the stress update is)
+      spin_needed = .false.
+      do m = 1, size(self%materials)
+         if (self%materials(m)%model%uses_spin .and. self%particles%material_last(m) >= self%particles%material_first(m)) &
+            spin_needed = .true.
+      end do
       call self%timers%switch_to(phase_particles_to_grid)
       call particles_to_grid(self%grid, self%particles, self%gravity)
       call self%timers%switch_to(phase_halo)
@@ -202,7 +215,7 @@ contains
 
       call self%timers%switch_to(phase_stabilization)
       do m = 1, size(self%schemes)
-         if (.not. allocated(self%schemes(m)%scheme)) cycle
+         if (.not. smoothed(m)) cycle
          call set_slice(m)
          call self%schemes(m)%scheme%prepare(context, self%particles)
       end do
@@ -213,16 +226,17 @@ contains
             call remap_velocities(self)
             call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
                                    update_velocity=.false., compute_strain=.true., update_position=.true., &
-                                   strain_velocity=self%remapped_momentum)
+                                   strain_velocity=self%remapped_momentum, compute_spin=spin_needed)
          else
             call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
-                                   update_velocity=.true., compute_strain=.true., update_position=.true.)
+                                   update_velocity=.true., compute_strain=.true., update_position=.true., &
+                                   compute_spin=spin_needed)
          end if
       end associate
 
       call self%timers%switch_to(phase_stabilization)
       do m = 1, size(self%schemes)
-         if (.not. allocated(self%schemes(m)%scheme)) cycle
+         if (.not. smoothed(m)) cycle
          call set_slice(m)
          call self%schemes(m)%scheme%filter_strain_rate(context, self%particles)
       end do
@@ -237,7 +251,7 @@ contains
       end do
       call self%timers%switch_to(phase_stabilization)
       do m = 1, size(self%schemes)
-         if (.not. allocated(self%schemes(m)%scheme)) cycle
+         if (.not. smoothed(m)) cycle
          call set_slice(m)
          call self%schemes(m)%scheme%filter_stress(context, self%particles)
       end do
@@ -274,6 +288,20 @@ contains
          context%last = self%particles%material_last(material)
       end subroutine set_slice
    end subroutine solver_advance
+
+   !> True if material m may have particles on some rank now: a body of it, or an inlet of it that has
+   !> opened. The same on every rank (scene and time only), so collective stages can be skipped by it.
+   !> A material whose particles all left through open sides still counts (the scheme then just idles).
+   logical function material_supplied(self, m) result(supplied)
+      type(solver_t), intent(in) :: self
+      integer, intent(in) :: m
+      integer :: i
+      supplied = .false.
+      if (allocated(self%scene%bodies)) supplied = any(self%scene%bodies%material_index == m)
+      do i = 1, size(self%inlets)
+         if (self%inlets(i)%spec%material_index == m .and. self%time >= self%inlets(i)%spec%start_time) supplied = .true.
+      end do
+   end function material_supplied
 
    !> Step 2: v^n = P/m, v^{n+1} = v^n + dt f/m, walls, dv = v^{n+1} - v^n (contains the wall correction).
    subroutine update_nodes(self, dt)
