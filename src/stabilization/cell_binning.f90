@@ -175,7 +175,7 @@ contains
             cell_mass(c) = running_mass
             c = cell(i)
             running_mass = cell_mass(c)
-            if (running_mass == 0.0_rp) then
+            if (running_mass <= 0.0_rp) then
                count = count + 1
                list(count) = c
             end if
@@ -237,7 +237,7 @@ contains
             moment(:, c) = running_moment
             c = cell(i)
             running_mass = cell_mass(c)
-            if (running_mass == 0.0_rp) then      ! first visit: the moment is not cleared in memory
+            if (running_mass <= 0.0_rp) then      ! first visit: the moment is not cleared in memory
                count = count + 1
                list(count) = c
                running_moment = 0.0_rp

@@ -74,7 +74,6 @@ contains
          call clear_box(box, workspace%written_lo, workspace%written_hi, dq)
       else
          allocate (workspace%oscillating(box%count), workspace%scale(box%count))
-         workspace%scale = 0.0_rp    ! read (and masked) next to the bounding box: must be finite
          dq = 0.0_rp
       end if
       call existing_bounds(box, exists, lo, hi)
@@ -86,10 +85,8 @@ contains
          do i3 = lo(3), hi(3)
             do i2 = lo(2), hi(2)
                c = flat_index(box, lo(1), i2, i3)
-               ! round-off scale (see noise_guard); of every cell, for the branch-free test below (the
-               ! values of a cell without the material are finite leftovers, and masked there)
                do i1 = lo(1), hi(1)
-                  scale(c) = noise_guard * maxval(abs(q(:, c)))
+                  if (exists(c)) scale(c) = noise_guard * maxval(abs(q(:, c)))     ! round-off scale (see noise_guard)
                   c = c + 1
                end do
             end do
@@ -181,8 +178,9 @@ contains
    !> Eq. 6 per component for the cells first..first + count - 1 along the axis of `stride`, as bits
    !> (bit j - 1: component j), with the noise guard: both differences above round-off and of opposite
    !> sign. 0 if the cell or a neighbour is missing (a cell missing a neighbour cannot be tested [?]).
-   !> Without branches: in a flow that has just been set in motion half the cells oscillate, at random,
-   !> and a branch per test was mispredicted half the time (measured on the collapsing water column).
+   !> The components are tested without branches: in a flow that has just been set in motion half the
+   !> cells oscillate, at random, and a branch per test was mispredicted half the time (measured on the
+   !> collapsing water column). Cells without the material are not read (their values are anything).
    subroutine row_oscillation_bits(nq, exists, scale, q, first, count, stride, oscillating)
       integer, intent(in) :: nq, first, count, stride
       logical, intent(in) :: exists(:)
@@ -191,6 +189,8 @@ contains
       real(rp) :: noise, left, right
       integer :: j, c, bits
       do c = first, first + count - 1
+         oscillating(c) = 0
+         if (.not. (exists(c) .and. exists(c - stride) .and. exists(c + stride))) cycle
          noise = max(scale(c - stride), scale(c), scale(c + stride))
          bits = 0
          do j = 1, nq
@@ -199,7 +199,7 @@ contains
             bits = ior(bits, merge(ishft(1, j - 1), 0, (abs(right) > noise) .and. (abs(left) > noise) .and. &
                                                        (right * left < 0.0_rp)))
          end do
-         oscillating(c) = merge(bits, 0, exists(c) .and. exists(c - stride) .and. exists(c + stride))
+         oscillating(c) = bits
       end do
    end subroutine row_oscillation_bits
 

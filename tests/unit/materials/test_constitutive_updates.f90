@@ -1,14 +1,14 @@
 !> Point updates of the constitutive models against closed-form results.
 module test_constitutive_updates
-   use kinds, only: rp
-   use assertions, only: assertEqual, assertRelativelyEqual
+   use kinds, only: rp, i8
+   use assertions, only: assertEqual, assertRelativelyEqual, assertTrue
    use tensor_layout, only: mean_stress
-   use newtonian_fluid, only: fluid_point_update
+   use newtonian_fluid, only: fluid_point_update, newtonian_fluid_t
    use linear_elastic, only: elastic_point_update
    implicit none
    private
 
-   public :: test_fluid_pressure_increment, test_fluid_viscous_stress, test_elastic_uniaxial_strain, &
+   public :: test_fluid_pressure_increment, test_fluid_viscous_stress, test_inviscid_update_bitwise, test_elastic_uniaxial_strain, &
              test_elastic_uniaxial_stress_nu0, test_jaumann_hydrostatic_invariance, test_jaumann_rotation_rate
 
 contains
@@ -47,6 +47,48 @@ contains
       call assertRelativelyEqual(2 * mu * d(4), sigma(4), 1.0e-14_rp, 'shear stress 2 mu d_xy')
       call assertRelativelyEqual(2 * mu * (d(1) - d(2)), sigma(1) - sigma(2), 1.0e-12_rp, 'normal stress difference')
    end subroutine test_fluid_viscous_stress
+
+   !> With viscosity 0 the slice update takes a path without the viscous terms: it must give the bits of
+   !> the general point update with mu = 0, signs of zero included (zero pressure, shear rates of both
+   !> signs and -0), in 2-D and 3-D.
+   subroutine test_inviscid_update_bitwise()
+      type(newtonian_fluid_t) :: fluid
+      real(rp), parameter :: dt = 1.0e-4_rp
+      real(rp) :: d(4, 3), sbar(4, 3), density(3), spin(1, 3), sbar_ref(4, 3), density_ref(3)
+      real(rp) :: d3(6, 2), sbar3(6, 2), density3(2), spin3(3, 2), sbar3_ref(6, 2), density3_ref(2)
+      integer :: p
+      fluid%bulk_modulus = 2.0e7_rp
+      fluid%viscosity = 0.0_rp
+      spin = 0.0_rp
+      spin3 = 0.0_rp
+      d(:, 1) = [-0.3_rp, 0.1_rp, 0.0_rp, -0.05_rp]
+      d(:, 2) = [0.0_rp, 0.0_rp, 0.0_rp, -0.0_rp]          ! at rest with zero stress: p = 0
+      d(:, 3) = [0.2_rp, -0.2_rp, 0.0_rp, 0.7_rp]           ! tr d = 0
+      sbar(:, 1) = [-30.0_rp, -30.0_rp, -30.0_rp, 0.0_rp]
+      sbar(:, 2) = 0.0_rp
+      sbar(:, 3) = 0.0_rp
+      density = [1000.0_rp, 1000.0_rp, 998.0_rp]
+      sbar_ref = sbar
+      density_ref = density
+      do p = 1, 3
+         call fluid_point_update(fluid%bulk_modulus, 0.0_rp, 2, dt, d(:, p), density_ref(p), sbar_ref(:, p))
+      end do
+      call fluid%update_stress(2, dt, d, spin, density, sbar)
+      call assertTrue(all(transfer(sbar, 0_i8, 12) == transfer(sbar_ref, 0_i8, 12)), '2-D sbar bit for bit')
+      call assertTrue(all(transfer(density, 0_i8, 3) == transfer(density_ref, 0_i8, 3)), '2-D density bit for bit')
+      d3(:, 1) = [0.2_rp, -0.1_rp, 0.4_rp, -0.01_rp, 0.0_rp, 0.03_rp]
+      d3(:, 2) = [0.1_rp, -0.1_rp, 0.0_rp, -0.0_rp, 0.0_rp, -0.03_rp]
+      sbar3 = 0.0_rp
+      density3 = 1000.0_rp
+      sbar3_ref = sbar3
+      density3_ref = density3
+      do p = 1, 2
+         call fluid_point_update(fluid%bulk_modulus, 0.0_rp, 3, dt, d3(:, p), density3_ref(p), sbar3_ref(:, p))
+      end do
+      call fluid%update_stress(3, dt, d3, spin3, density3, sbar3)
+      call assertTrue(all(transfer(sbar3, 0_i8, 12) == transfer(sbar3_ref, 0_i8, 12)), '3-D sbar bit for bit')
+      call assertTrue(all(transfer(density3, 0_i8, 2) == transfer(density3_ref, 0_i8, 2)), '3-D density bit for bit')
+   end subroutine test_inviscid_update_bitwise
 
    !> Uniaxial strain in 3-D: sigma_xx = (lambda + 2 G) eps, sigma_yy = sigma_zz = lambda eps.
    subroutine test_elastic_uniaxial_strain()
