@@ -33,8 +33,7 @@ contains
       integer(i8), intent(in) :: steps, local_particle_steps
       type(status_t), intent(inout) :: status
       integer(i8) :: particle_steps, peak(1), total(1)
-      integer :: rank, ranks, unit, ios
-      character(len=256) :: message
+      integer :: rank, ranks, unit
       real(rp) :: rate
 
       call MPI_Comm_rank(comm, rank)
@@ -48,19 +47,12 @@ contains
       if (rank /= 0) return
       rate = 0.0_rp
       if (wall_seconds > 0.0_rp) rate = real(particle_steps, rp) / (wall_seconds * ranks)
-      open (newunit=unit, file=dir//'/'//run_summary_file//temporary_suffix, status='replace', action='write', &
-            iostat=ios, iomsg=message)
-      if (ios /= 0) then
-         call status%fail('cannot write '//dir//'/'//run_summary_file//': '//trim(message))
-         return
-      end if
+      if (.not. opened(dir, run_summary_file, unit, status)) return
       write (unit, '(a)') 'wall_seconds,steps,particle_steps,particle_steps_per_second_per_core,ranks,'// &
          'peak_memory_bytes,peak_memory_bytes_total,outcome'
       write (unit, '(a)') real_text(wall_seconds)//','//int_text(steps)//','//int_text(particle_steps)//','// &
          real_text(rate)//','//int_text(ranks)//','//int_text(peak(1))//','//int_text(total(1))//','//outcome
-      close (unit)
-      if (.not. rename_path(dir//'/'//run_summary_file//temporary_suffix, dir//'/'//run_summary_file)) &
-         call status%fail('cannot rename '//dir//'/'//run_summary_file//temporary_suffix)
+      call publish(dir, run_summary_file, unit, status)
    end subroutine write_run_summary
 
    !> Collective over `comm`: rank 0 writes <dir>/timing.csv (replacing it) from every rank's `seconds`
@@ -72,8 +64,7 @@ contains
       character(len=*), intent(in) :: names(:)
       type(status_t), intent(inout) :: status
       real(rp) :: largest(size(seconds)), mean(size(seconds)), total
-      integer :: rank, ranks, unit, ios, k
-      character(len=256) :: message
+      integer :: rank, ranks, unit, k
 
       call MPI_Comm_rank(comm, rank)
       call MPI_Comm_size(comm, ranks)
@@ -82,20 +73,36 @@ contains
       if (rank /= 0) return
       mean = mean / ranks
       total = sum(mean)
-      open (newunit=unit, file=dir//'/'//timing_file//temporary_suffix, status='replace', action='write', &
-            iostat=ios, iomsg=message)
-      if (ios /= 0) then
-         call status%fail('cannot write '//dir//'/'//timing_file//': '//trim(message))
-         return
-      end if
+      if (.not. opened(dir, timing_file, unit, status)) return
       write (unit, '(a)') 'phase,seconds_max,seconds_mean,share'
       do k = 1, size(seconds)
          write (unit, '(a)') trim(names(k))//','//real_text(largest(k))//','//real_text(mean(k))//','// &
             real_text(merge(mean(k) / total, 0.0_rp, total > 0.0_rp))
       end do
       write (unit, '(a)') 'total,'//real_text(sum(largest))//','//real_text(total)//',1'
-      close (unit)
-      if (.not. rename_path(dir//'/'//timing_file//temporary_suffix, dir//'/'//timing_file)) &
-         call status%fail('cannot rename '//dir//'/'//timing_file//temporary_suffix)
+      call publish(dir, timing_file, unit, status)
    end subroutine write_timing
+
+   !> Open <dir>/<name>.tmp for writing as `unit`; false (and status failed) if it cannot be.
+   logical function opened(dir, name, unit, status)
+      character(len=*), intent(in) :: dir, name
+      integer, intent(out) :: unit
+      type(status_t), intent(inout) :: status
+      integer :: ios
+      character(len=256) :: message
+      open (newunit=unit, file=dir//'/'//name//temporary_suffix, status='replace', action='write', iostat=ios, &
+            iomsg=message)
+      opened = ios == 0
+      if (.not. opened) call status%fail('cannot write '//dir//'/'//name//': '//trim(message))
+   end function opened
+
+   !> Close `unit` and rename <dir>/<name>.tmp to its final name (the file is complete).
+   subroutine publish(dir, name, unit, status)
+      character(len=*), intent(in) :: dir, name
+      integer, intent(in) :: unit
+      type(status_t), intent(inout) :: status
+      close (unit)
+      if (.not. rename_path(dir//'/'//name//temporary_suffix, dir//'/'//name)) &
+         call status%fail('cannot rename '//dir//'/'//name//temporary_suffix)
+   end subroutine publish
 end module run_summary

@@ -52,43 +52,46 @@ contains
    !> the general point update with mu = 0, signs of zero included (zero pressure, shear rates of both
    !> signs and -0), in 2-D and 3-D.
    subroutine test_inviscid_update_bitwise()
-      type(newtonian_fluid_t) :: fluid
-      real(rp), parameter :: dt = 1.0e-4_rp
-      real(rp) :: d(4, 3), sbar(4, 3), density(3), spin(1, 3), sbar_ref(4, 3), density_ref(3)
-      real(rp) :: d3(6, 2), sbar3(6, 2), density3(2), spin3(3, 2), sbar3_ref(6, 2), density3_ref(2)
-      integer :: p
-      fluid%bulk_modulus = 2.0e7_rp
-      fluid%viscosity = 0.0_rp
-      spin = 0.0_rp
-      spin3 = 0.0_rp
+      real(rp) :: d(4, 3), sbar(4, 3), d3(6, 2), sbar3(6, 2)
       d(:, 1) = [-0.3_rp, 0.1_rp, 0.0_rp, -0.05_rp]
       d(:, 2) = [0.0_rp, 0.0_rp, 0.0_rp, -0.0_rp]          ! at rest with zero stress: p = 0
       d(:, 3) = [0.2_rp, -0.2_rp, 0.0_rp, 0.7_rp]           ! tr d = 0
-      sbar(:, 1) = [-30.0_rp, -30.0_rp, -30.0_rp, 0.0_rp]
-      sbar(:, 2) = 0.0_rp
-      sbar(:, 3) = 0.0_rp
-      density = [1000.0_rp, 1000.0_rp, 998.0_rp]
-      sbar_ref = sbar
-      density_ref = density
-      do p = 1, 3
-         call fluid_point_update(fluid%bulk_modulus, 0.0_rp, 2, dt, d(:, p), density_ref(p), sbar_ref(:, p))
-      end do
-      call fluid%update_stress(2, dt, d, spin, density, sbar)
-      call assertTrue(all(transfer(sbar, 0_i8, 12) == transfer(sbar_ref, 0_i8, 12)), '2-D sbar bit for bit')
-      call assertTrue(all(transfer(density, 0_i8, 3) == transfer(density_ref, 0_i8, 3)), '2-D density bit for bit')
+      sbar = 0.0_rp
+      sbar(1:3, 1) = -30.0_rp
+      call check_inviscid_slice(2, d, sbar, '2-D')
       d3(:, 1) = [0.2_rp, -0.1_rp, 0.4_rp, -0.01_rp, 0.0_rp, 0.03_rp]
       d3(:, 2) = [0.1_rp, -0.1_rp, 0.0_rp, -0.0_rp, 0.0_rp, -0.03_rp]
       sbar3 = 0.0_rp
-      density3 = 1000.0_rp
-      sbar3_ref = sbar3
-      density3_ref = density3
-      do p = 1, 2
-         call fluid_point_update(fluid%bulk_modulus, 0.0_rp, 3, dt, d3(:, p), density3_ref(p), sbar3_ref(:, p))
-      end do
-      call fluid%update_stress(3, dt, d3, spin3, density3, sbar3)
-      call assertTrue(all(transfer(sbar3, 0_i8, 12) == transfer(sbar3_ref, 0_i8, 12)), '3-D sbar bit for bit')
-      call assertTrue(all(transfer(density3, 0_i8, 2) == transfer(density3_ref, 0_i8, 2)), '3-D density bit for bit')
+      call check_inviscid_slice(3, d3, sbar3, '3-D')
    end subroutine test_inviscid_update_bitwise
+
+   !> The slice update of an inviscid fluid against fluid_point_update with mu = 0, bit for bit.
+   subroutine check_inviscid_slice(dim, d, sbar, label)
+      integer, intent(in) :: dim
+      real(rp), intent(in) :: d(:, :), sbar(:, :)
+      character(len=*), intent(in) :: label
+      real(rp), parameter :: dt = 1.0e-4_rp, k = 2.0e7_rp
+      type(newtonian_fluid_t) :: fluid
+      real(rp) :: spin(3, size(d, 2)), slice_sbar(size(sbar, 1), size(sbar, 2)), point_sbar(size(sbar, 1), size(sbar, 2))
+      real(rp) :: slice_density(size(d, 2)), point_density(size(d, 2))
+      integer :: p, n
+      fluid%bulk_modulus = k
+      fluid%viscosity = 0.0_rp
+      spin = 0.0_rp
+      n = size(d, 2)
+      slice_density = 1000.0_rp - [(2.0_rp * p, p = 1, n)]
+      point_density = slice_density
+      slice_sbar = sbar
+      point_sbar = sbar
+      do p = 1, n
+         call fluid_point_update(k, 0.0_rp, dim, dt, d(:, p), point_density(p), point_sbar(:, p))
+      end do
+      call fluid%update_stress(dim, dt, d, spin, slice_density, slice_sbar)
+      call assertTrue(all(transfer(slice_sbar, 0_i8, size(sbar)) == transfer(point_sbar, 0_i8, size(sbar))), &
+                      label//' sbar bit for bit')
+      call assertTrue(all(transfer(slice_density, 0_i8, n) == transfer(point_density, 0_i8, n)), &
+                      label//' density bit for bit')
+   end subroutine check_inviscid_slice
 
    !> Uniaxial strain in 3-D: sigma_xx = (lambda + 2 G) eps, sigma_yy = sigma_zz = lambda eps.
    subroutine test_elastic_uniaxial_strain()
