@@ -5,7 +5,7 @@
 !> Steps and particle-steps count this invocation only (a restarted run reports its continuation).
 !> `timing.csv` beside it: the time loop's wall time per phase (phase_timers), one row per phase:
 !>   phase, seconds_max (the slowest rank's), seconds_mean (over the ranks), share (of the mean loop time)
-!> and a last row `total`.
+!> and a last row `total` (seconds_max: the largest of the ranks' sums, not the sum of the maxima).
 module run_summary
    use kinds, only: rp, i8
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_Comm_rank, MPI_Comm_size, MPI_IN_PLACE, MPI_INTEGER8, &
@@ -63,13 +63,14 @@ contains
       real(rp), intent(in) :: seconds(:)
       character(len=*), intent(in) :: names(:)
       type(status_t), intent(inout) :: status
-      real(rp) :: largest(size(seconds)), mean(size(seconds)), total
+      real(rp) :: largest(size(seconds)), mean(size(seconds)), total, largest_total
       integer :: rank, ranks, unit, k
 
       call MPI_Comm_rank(comm, rank)
       call MPI_Comm_size(comm, ranks)
       call MPI_Allreduce(seconds, largest, size(seconds), MPI_DOUBLE_PRECISION, MPI_MAX, comm)
       call MPI_Allreduce(seconds, mean, size(seconds), MPI_DOUBLE_PRECISION, MPI_SUM, comm)
+      call MPI_Allreduce(sum(seconds), largest_total, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
       if (rank /= 0) return
       mean = mean / ranks
       total = sum(mean)
@@ -79,7 +80,7 @@ contains
          write (unit, '(a)') trim(names(k))//','//real_text(largest(k))//','//real_text(mean(k))//','// &
             real_text(merge(mean(k) / total, 0.0_rp, total > 0.0_rp))
       end do
-      write (unit, '(a)') 'total,'//real_text(sum(largest))//','//real_text(total)//',1'
+      write (unit, '(a)') 'total,'//real_text(largest_total)//','//real_text(total)//',1'
       call publish(dir, timing_file, unit, status)
    end subroutine write_timing
 
