@@ -1,6 +1,8 @@
 !> Benchmark driver: `mpirun -np N flotsam_bench scene.nml steps [output]`. Runs a scene for a fixed
 !> number of steps without output and prints one line of figures (scripts/bench collects them):
 !>   dim ranks particles steps seconds particle_steps_per_s_per_core bytes_per_particle
+!> preceded by a line of the timed steps' wall time per phase (phase_timers; the slowest rank's):
+!>   phases <name>=<seconds> ...
 !> Memory per particle is the growth of the resident set from before the solver is built to after the
 !> timed steps, divided by the rank's particles (rank 0's view).
 !> With `output`, it then times the output of the final state into the scene's output_dir (replaced):
@@ -11,7 +13,7 @@ program flotsam_bench
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use kinds, only: rp, i8
    use mpi_f08, only: MPI_Init, MPI_Finalize, MPI_Comm_rank, MPI_Comm_size, MPI_Barrier, MPI_Wtime, MPI_COMM_WORLD, &
-                      MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER, MPI_MAX
+                      MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER, MPI_MAX, MPI_DOUBLE_PRECISION
    use error_status, only: status_t
    use scene_description, only: scene_t
    use scene_reader, only: read_scene
@@ -25,6 +27,7 @@ program flotsam_bench
    use health_check, only: particles_healthy
    use simulation, only: blow_up_speed
    use process_memory, only: resident_bytes
+   use phase_timers, only: phase_names, phase_rebalance, phase_other
    implicit none
 
    type(scene_t) :: scene
@@ -67,14 +70,18 @@ program flotsam_bench
       call advance()
    end do
    call MPI_Barrier(MPI_COMM_WORLD)
+   call solver%timers%reset()
    t0 = MPI_Wtime()
+   call solver%timers%switch_to(phase_other)
    do step = 1, steps
       call advance()
    end do
    call MPI_Barrier(MPI_COMM_WORLD)
    t1 = MPI_Wtime()
+   call solver%timers%switch_to(phase_other)
    rss_after = real(resident_bytes(), rp)
    diag = solver%diagnostics()
+   call print_phases()
    if (rank == 0) write (output_unit, '(i0,1x,i0,1x,i0,1x,i0,1x,es12.5,1x,es12.5,1x,f10.1)') scene%grid%dim, n_ranks, &
       diag%particles, steps, t1 - t0, real(diag%particles, rp) * steps / ((t1 - t0) * n_ranks), &
       (rss_after - rss_before) / max(1, solver%particles%count)
@@ -87,9 +94,26 @@ contains
    !> A step and, as in the time loop, the balance check every rebalance_interval steps.
    subroutine advance()
       call solver%advance()
-      if (mod(solver%step, int(scene%run%rebalance_interval, i8)) == 0) call solver%balance_load(status)
+      if (mod(solver%step, int(scene%run%rebalance_interval, i8)) == 0) then
+         call solver%timers%switch_to(phase_rebalance)
+         call solver%balance_load(status)
+         call solver%timers%switch_to(phase_other)
+      end if
       if (.not. status%ok) call bench_failure()
    end subroutine advance
+
+   !> The `phases` line: each phase's seconds over the timed steps, the largest over the ranks.
+   subroutine print_phases()
+      real(rp) :: largest(size(phase_names))
+      integer :: k
+      call MPI_Allreduce(solver%timers%seconds, largest, size(largest), MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
+      if (rank /= 0) return
+      write (output_unit, '(a)', advance='no') 'phases'
+      do k = 1, size(phase_names)
+         write (output_unit, '(1x,a,"=",es10.3)', advance='no') trim(phase_names(k)), largest(k)
+      end do
+      write (output_unit, '(a)') ''
+   end subroutine print_phases
 
    !> Time the output of the current state: fields file, checkpoint, health check (see the header).
    subroutine time_output(step_seconds)

@@ -48,19 +48,24 @@ contains
    !>   v_p := alpha (v_p + sum N dv_i) + (1 - alpha) sum N v_i^{n+1}                  (if update_velocity)
    !>   x_p := x_p + dt sum N v_i^{n+theta}                                             (if update_position)
    !> `strain_velocity`, when present, replaces v^{n+theta} in L (MUSL: the re-mapped velocities).
+   !> `compute_spin` (default: as compute_strain) = .false. leaves the spin alone: only solids use it.
    subroutine grid_to_particles(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
-                                update_position, strain_velocity)
+                                update_position, strain_velocity, compute_spin)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
       real(rp), intent(in) :: dt, flip_fraction, theta
       logical, intent(in) :: update_velocity, compute_strain, update_position
       real(rp), intent(in), optional :: strain_velocity(:, :)
+      logical, intent(in), optional :: compute_spin
+      logical :: spin
+      spin = compute_strain
+      if (present(compute_spin)) spin = compute_strain .and. compute_spin
       if (grid%dim == 2) then
          call grid_to_particles_2d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
-                                   update_position, strain_velocity)
+                                   spin, update_position, strain_velocity)
       else
          call grid_to_particles_3d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
-                                   update_position, strain_velocity)
+                                   spin, update_position, strain_velocity)
       end if
    end subroutine grid_to_particles
 
