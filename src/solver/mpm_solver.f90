@@ -37,7 +37,8 @@ module mpm_solver
    use status_broadcast, only: agree_on_status
    use phase_timers, only: phase_timers_t, phase_particles_to_grid, phase_grid_update, phase_walls, &
                            phase_stabilization, phase_grid_to_particles, phase_constitutive, phase_inflow, &
-                           phase_halo, phase_migration, phase_sort, phase_time_step, phase_other
+                           phase_halo, phase_migration, phase_sort, phase_time_step, phase_volume_correction, &
+                           phase_other
    implicit none
    private
 
@@ -195,7 +196,10 @@ contains
       dt = self%dt
       call self%timers%switch_to(phase_walls)
       call set_wall_activity(self%walls, self%time)
-      call self%volume%prepare(self%domain, self%grid, self%walls, self%particles)
+      if (self%volume%shifting) then
+         call self%timers%switch_to(phase_volume_correction)
+         call self%volume%prepare(self%domain, self%grid, self%walls, self%particles, self%step)
+      end if
       context%domain => self%domain
       context%grid => self%grid
       context%dt = dt
@@ -238,7 +242,10 @@ contains
                                    compute_spin=spin_needed)
          end if
       end associate
-      call self%volume%apply_shifts(self%particles)
+      if (self%volume%shifting_now) then
+         call self%timers%switch_to(phase_volume_correction)
+         call self%volume%apply_shifts(self%particles)
+      end if
 
       call self%timers%switch_to(phase_stabilization)
       do m = 1, size(self%schemes)
@@ -261,7 +268,10 @@ contains
          call set_slice(m)
          call self%schemes(m)%scheme%filter_stress(context, self%particles)
       end do
-      call self%volume%relax_pressure(self%particles)
+      if (self%volume%active()) then
+         call self%timers%switch_to(phase_volume_correction)
+         call self%volume%relax_pressure(self%particles)
+      end if
 
       call self%timers%switch_to(phase_walls)
       call keep_particles_inside(self%walls, self%grid, self%particles, self%wall_corrections)
