@@ -407,7 +407,8 @@ def figure_volume(args):
         limits = ((-0.1, 3.3), (-0.1, 3.4)) if key == "tank45" else ((-0.1, 3.1), (-0.1, 2.4))
         for ax, (label, folder) in zip(axes, folders.items()):
             t, state = list(fields(folder))[-1]
-            art = scatter(ax, state, "%s, t = %.0f s" % (label, t), limits, -35 if key == "tank45" else -25, 0)
+            art = scatter(ax, state, "%s\nt = %.0f s" % (label.replace(" + eos", "\n+ eos"), t), limits,
+                          -35 if key == "tank45" else -25, 0)
         fig.colorbar(art, ax=axes, label="mean stress [kPa]", shrink=0.8)
         save(fig, "volume_%s_particles.png" % key)
     m = volume_measures(aligned, 3.2, 0.4 / 3)
