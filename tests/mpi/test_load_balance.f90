@@ -3,6 +3,7 @@
 !> rebalance_interval steps). The diagnostics agree to round-off (relative 1e-10, as between rank
 !> counts: only the order of the particle-grid sums changes), the layout did change, and afterwards the
 !> largest rank holds at most 60 % of the particles on 2 ranks (a lower share than without on more).
+!> Without rebalancing the slabs of the active region keep their inner cuts (section 6.2).
 module test_load_balance
    use kinds, only: rp, i8
    use mpi_f08, only: MPI_Comm, MPI_Comm_size
@@ -22,9 +23,10 @@ module test_load_balance
 
 contains
 
-   !> A 1 m x 1 m water column in the corner of a 4 m x 2 m box: on 2 ranks (split along x at 2 m)
-   !> all particles start on rank 0. Standard MPM and each stabilization scheme (their cell arrays
-   !> follow the new box).
+   !> A 1 m x 1 m water column in the corner of a 4 m x 2 m box. The active region starts at the column,
+   !> split evenly; as the column collapses to the right the region grows with the last slab, which
+   !> gathers the water (without rebalancing the largest rank holds 68 % on 2 ranks, 49 % on 4 after
+   !> 200 steps). Standard MPM and each stabilization scheme (their cell arrays follow the new box).
    subroutine test_collapsing_column_rebalanced(comm)
       type(MPI_Comm), intent(in) :: comm
       character(len=5), parameter :: schemes(4) = [character(len=5) :: 'none', 'C0', 'NB', 'FOAL1']
@@ -85,8 +87,8 @@ contains
          call assertTrue(all(cuts_on == cuts_off), 'one rank: nothing to balance'//what)
          return
       end if
-      call assertTrue(off%max_rank_share > 0.99_rp, 'without rebalancing one rank holds (nearly) all, share '// &
-                      real_text(off%max_rank_share)//what)
+      call assertTrue(off%max_rank_share > 1.3_rp / nranks, 'without rebalancing one rank holds more than 1.3 times '// &
+                      'its share, share '//real_text(off%max_rank_share)//what)
       call assertTrue(any(cuts_on /= cuts_off), 'rebalancing moved the cuts'//what)
       call assertTrue(on%max_rank_share < off%max_rank_share, 'rebalanced share '//real_text(on%max_rank_share)// &
                       ' below '//real_text(off%max_rank_share)//what)
