@@ -374,14 +374,27 @@ contains
       call MPI_Allreduce(MPI_IN_PLACE, dt, 1, MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
    end function solver_stable_time_step
 
-   !> This rank's stable step (see solver_stable_time_step) and the largest signal speed c + |v| of its
-   !> particles and open inlets, `speed` [m/s], which bounds how far a particle can move in a step.
-   !> An inlet that is not closed yet counts as a particle of its fluid at rho0 moving at v0: the step
-   !> must resolve the fluid it is about to create (and an empty tank must not take a huge step).
+   !> This rank's stable step (see solver_stable_time_step) and a bound `speed` [m/s] on how fast its
+   !> particles move: the largest signal speed c + |v| of its particles and open inlets, or with a fixed
+   !> step a bound on the largest |v| (the sound speed is not needed then, and a blowing-up state may
+   !> have no valid one). An inlet that is not closed yet counts as a particle of its fluid at rho0 moving at
+   !> v0: the step must resolve the fluid it is about to create (and an empty tank must not take a huge
+   !> step).
    subroutine local_time_step(self, dt, speed)
       type(solver_t), intent(in) :: self
       real(rp), intent(out) :: dt, speed
-      integer :: m, first, last, i
+      integer :: m, first, last, i, n
+      n = self%particles%count
+      if (self%run%fixed_dt > 0.0_rp) then
+         dt = self%run%fixed_dt
+         speed = 0.0_rp
+         ! sqrt(dim) max |v_k| >= |v|, without squares that could overflow in a blowing-up state
+         if (n > 0) speed = sqrt(real(self%grid%dim, rp)) * maxval(abs(self%particles%v(:, 1:n)))
+         do i = 1, size(self%inlets)
+            if (self%time < self%inlets(i)%spec%end_time) speed = max(speed, self%inlets(i)%spec%velocity)
+         end do
+         return
+      end if
       speed = 0.0_rp
       dt = huge(1.0_rp)
       do m = 1, size(self%materials)
@@ -398,10 +411,6 @@ contains
                                                           [self%grid%dim, 1])))
          end associate
       end do
-      if (self%run%fixed_dt > 0.0_rp) then
-         dt = self%run%fixed_dt
-         return
-      end if
       if (speed > 0.0_rp) dt = self%run%cfl * self%grid%h / (sqrt(real(self%grid%dim, rp)) * speed)
       dt = min(dt, viscous_time_step(self))
    end subroutine local_time_step
