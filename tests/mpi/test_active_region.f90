@@ -11,8 +11,9 @@ module test_active_region
    use mpm_solver, only: solver_t
    use run_diagnostics, only: diagnostics_t
    use input_text, only: real_text, int_text
-   use test_scenes, only: water_scene, add_body, tank_with_inlet
+   use test_scenes, only: water_scene, add_body, tank_with_inlet, corner_column
    use active_region, only: slack_cells
+   use time_loop_steps, only: start_run, step_run
    implicit none
    private
 
@@ -34,9 +35,7 @@ contains
       type(scene_t) :: scene
       integer :: i
       do i = 1, size(schemes)
-         scene = water_scene(2, 0.05_rp, [2.0_rp, 1.0_rp, 0.0_rp], 2.0e6_rp, 9.81_rp)
-         call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [0.5_rp, 0.5_rp, 0.0_rp], 2, .false., 0.0_rp)
-         scene%materials(1)%stabilization = schemes(i)
+         scene = corner_column([2.0_rp, 1.0_rp], 0.5_rp, schemes(i))
          call compare_with_padded(comm, scene, 300, 'collapsing column, '//trim(schemes(i)))
       end do
    end subroutine test_padded_column_is_identical
@@ -91,15 +90,13 @@ contains
       integer :: dim, lo(3), hi(3)
 
       dim = scene%grid%dim
-      call solver%init(scene, comm, status)
+      call start_run(solver, scene, comm, status)
       call assertTrue(status%ok, 'solver init: '//trim(status%message))
-      call solver%balance_load(status)
       before = solver%diagnostics()
       call block_shape(comm, solver, centre_before, size_before)
       largest_fraction = 0.0_rp
       do while (solver%time < end_time)
-         call solver%advance()
-         if (mod(solver%step, int(scene%run%rebalance_interval, i8)) == 0) call solver%balance_load(status)
+         call step_run(solver, status)
          call solver%domain%region(lo, hi)
          largest_fraction = max(largest_fraction, real(product(hi(1:dim) - lo(1:dim) + 1), rp) / &
                                 product(real(solver%domain%global_cells(1:dim), rp)))
@@ -207,12 +204,10 @@ contains
       integer, allocatable :: seen(:)
       integer :: step, p, dim, rows, column
 
-      call solver%init(scene, comm, status)
+      call start_run(solver, scene, comm, status)
       call assertTrue(status%ok, 'solver init: '//trim(status%message))
-      call solver%balance_load(status)
       do step = 1, n_steps
-         call solver%advance()
-         if (mod(solver%step, int(scene%run%rebalance_interval, i8)) == 0) call solver%balance_load(status)
+         call step_run(solver, status)
       end do
       call assertTrue(status%ok, 'balance: '//trim(status%message))
       diag = solver%diagnostics()

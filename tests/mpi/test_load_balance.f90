@@ -13,7 +13,8 @@ module test_load_balance
    use mpm_solver, only: solver_t
    use run_diagnostics, only: diagnostics_t
    use input_text, only: real_text
-   use test_scenes, only: water_scene, add_body, tank_with_inlet
+   use test_scenes, only: tank_with_inlet, corner_column
+   use time_loop_steps, only: start_run, step_run
    implicit none
    private
 
@@ -33,10 +34,8 @@ contains
       type(scene_t) :: scene
       integer :: i
       do i = 1, size(schemes)
-         scene = water_scene(2, 0.05_rp, [4.0_rp, 2.0_rp, 0.0_rp], 2.0e6_rp, 9.81_rp)
-         call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [1.0_rp, 1.0_rp, 0.0_rp], 2, .false., 0.0_rp)
+         scene = corner_column([4.0_rp, 2.0_rp], 1.0_rp, schemes(i))
          scene%run%fixed_dt = 5.0e-4_rp
-         scene%materials(1)%stabilization = schemes(i)
          call compare_with_and_without(comm, scene, 'collapsing column, '//trim(schemes(i)))
       end do
    end subroutine test_collapsing_column_rebalanced
@@ -105,12 +104,10 @@ contains
       type(solver_t) :: solver
       type(status_t) :: status
       integer :: step
-      call solver%init(scene, comm, status)
+      call start_run(solver, scene, comm, status)
       call assertTrue(status%ok, 'solver init: '//trim(status%message))
-      call solver%balance_load(status)
       do step = 1, n_steps
-         call solver%advance()
-         if (mod(solver%step, int(scene%run%rebalance_interval, i8)) == 0) call solver%balance_load(status)
+         call step_run(solver, status)
       end do
       call assertTrue(status%ok, 'balance: '//trim(status%message))
       diag = solver%diagnostics()
