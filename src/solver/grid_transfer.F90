@@ -48,19 +48,29 @@ contains
    !>   v_p := alpha (v_p + sum N dv_i) + (1 - alpha) sum N v_i^{n+1}                  (if update_velocity)
    !>   x_p := x_p + dt sum N v_i^{n+theta}                                             (if update_position)
    !> `strain_velocity`, when present, replaces v^{n+theta} in L (MUSL: the re-mapped velocities).
+   !> `extent` returns the lowest (:, 1) and highest (:, 2) new position along each axis (with
+   !> update_position; 0 beyond dim): the active region's check needs it, and here it costs no pass.
    subroutine grid_to_particles(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
-                                update_position, strain_velocity)
+                                update_position, strain_velocity, extent)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
       real(rp), intent(in) :: dt, flip_fraction, theta
       logical, intent(in) :: update_velocity, compute_strain, update_position
       real(rp), intent(in), optional :: strain_velocity(:, :)
+      real(rp), intent(out), optional :: extent(3, 2)
+      real(rp) :: lo(3), hi(3)
+      lo = 0.0_rp
+      hi = 0.0_rp
       if (grid%dim == 2) then
          call grid_to_particles_2d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
-                                   update_position, strain_velocity)
+                                   update_position, lo(1:2), hi(1:2), strain_velocity)
       else
          call grid_to_particles_3d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
-                                   update_position, strain_velocity)
+                                   update_position, lo, hi, strain_velocity)
+      end if
+      if (present(extent)) then
+         extent(:, 1) = lo
+         extent(:, 2) = hi
       end if
    end subroutine grid_to_particles
 

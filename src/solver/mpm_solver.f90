@@ -62,6 +62,7 @@ module mpm_solver
       real(rp) :: mass_tolerance = 0.0_rp       !< nodes lighter than this carry no velocity
       logical :: musl = .false.
       real(rp), allocatable :: remapped_momentum(:, :)
+      real(rp) :: extent(3, 2) = 0.0_rp         !< lowest and highest particle position after the last move
       integer :: relayouts = 0                  !< layouts made because the particles outgrew the active region
    contains
       procedure :: init => solver_init
@@ -269,10 +270,11 @@ contains
             call remap_velocities(self)
             call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
                                    update_velocity=.false., compute_strain=.true., update_position=.true., &
-                                   strain_velocity=self%remapped_momentum)
+                                   strain_velocity=self%remapped_momentum, extent=self%extent)
          else
             call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
-                                   update_velocity=.true., compute_strain=.true., update_position=.true.)
+                                   update_velocity=.true., compute_strain=.true., update_position=.true., &
+                                   extent=self%extent)
          end if
       end associate
 
@@ -428,11 +430,13 @@ contains
       type(status_t) :: status
 
       dim = self%grid%dim
-      ! all as minima: [dt, -speed, lo(1:3), -hi(1:3)]
+      ! all as minima: [dt, -speed, lo(1:3), -hi(1:3)]. The extent is that of the positions the step
+      ! computed (no pass of its own): the safeguard then moves particles only back behind walls, by less
+      ! than the step's travel, and inlets inject into their openings, which the region covers anyway.
       call local_time_step(self, values(1), speed)
       values(2) = -speed
-      call particle_extent(self%particles, values(3:5), values(6:8))
-      values(6:8) = -values(6:8)
+      values(3:5) = self%extent(:, 1)
+      values(6:8) = -self%extent(:, 2)
       call MPI_Allreduce(MPI_IN_PLACE, values, size(values), MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
       self%dt = values(1)
       speed = -values(2)
