@@ -30,8 +30,7 @@ module domain_decomposition
       integer :: coords(3) = 0                    !< this rank's position in the rank grid
       integer :: neighbour(2, 3) = -1             !< lower/upper face neighbour (MPI_PROC_NULL at the edge)
       integer :: global_cells(3) = 1              !< cells of the whole grid along each axis
-      integer, allocatable :: cuts(:, :)          !< (0:nranks, axis) first cell of each rank slab, then the
-                                                  !< end of the active region, then 0
+      integer, allocatable :: cuts(:, :)          !< (0:nranks, axis) first cell of each slab, region end, 0s
       integer :: cell_lo(3) = 0, cell_hi(3) = 0   !< owned cells, global 0-based inclusive
    contains
       procedure :: init => domain_init
