@@ -98,6 +98,9 @@ module scene_reader
       variable_info_t('material', 'gamma_max', 'real', .false.), &
       variable_info_t('material', 'smoothed_variables', 'string', .false.), &
       variable_info_t('material', 'cell_averaging', 'logical', .false.), &
+      variable_info_t('material', 'volume_correction', 'string', .false.), &
+      variable_info_t('material', 'shifting_coefficient', 'real', .false.), &
+      variable_info_t('material', 'eos_relaxation_rate', 'real', .false.), &
       variable_info_t('body', 'material', 'string', .true.), &
       variable_info_t('body', 'lower', 'real3', .true.), &
       variable_info_t('body', 'upper', 'real3', .true.), &
@@ -857,11 +860,13 @@ contains
       character(len=*), intent(inout) :: message
       integer, intent(in), optional :: unit
       character(len=*), intent(in), optional :: text
-      character(len=text_len) :: name, model, stabilization, oscillation_rule, smoothed_variables
-      real(rp) :: density, bulk_modulus, viscosity, youngs_modulus, poisson_ratio, gamma_max
+      character(len=text_len) :: name, model, stabilization, oscillation_rule, smoothed_variables, volume_correction
+      real(rp) :: density, bulk_modulus, viscosity, youngs_modulus, poisson_ratio, gamma_max, shifting_coefficient, &
+                  eos_relaxation_rate
       logical :: volumetric_only, cell_averaging
       namelist /material/ name, model, density, bulk_modulus, viscosity, youngs_modulus, poisson_ratio, stabilization, &
-         volumetric_only, oscillation_rule, gamma_max, smoothed_variables, cell_averaging
+         volumetric_only, oscillation_rule, gamma_max, smoothed_variables, cell_averaging, volume_correction, &
+         shifting_coefficient, eos_relaxation_rate
 
       name = spec%name
       model = spec%model
@@ -876,6 +881,9 @@ contains
       gamma_max = spec%gamma_max
       smoothed_variables = spec%smoothed_variables
       cell_averaging = spec%cell_averaging
+      volume_correction = spec%volume_correction
+      shifting_coefficient = spec%shifting_coefficient
+      eos_relaxation_rate = spec%eos_relaxation_rate
       if (present(text)) then
          read (text, nml=material, iostat=ios, iomsg=message)
       else
@@ -886,6 +894,7 @@ contains
       call check_length('stabilization', stabilization, len(spec%stabilization), ios, message)
       call check_length('oscillation_rule', oscillation_rule, len(spec%oscillation_rule), ios, message)
       call check_length('smoothed_variables', smoothed_variables, len(spec%smoothed_variables), ios, message)
+      call check_length('volume_correction', volume_correction, len(spec%volume_correction), ios, message)
       if (ios /= 0) return
       spec%name = name(1:len(spec%name))
       spec%model = lower_case(adjustl(model))
@@ -900,6 +909,9 @@ contains
       spec%gamma_max = gamma_max
       spec%smoothed_variables = lower_case(adjustl(smoothed_variables))
       spec%cell_averaging = cell_averaging
+      spec%volume_correction = lower_case(adjustl(volume_correction))
+      spec%shifting_coefficient = shifting_coefficient
+      spec%eos_relaxation_rate = eos_relaxation_rate
    end subroutine read_material_group
 
    subroutine read_body_group(spec, ios, message, unit, text)

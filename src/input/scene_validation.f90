@@ -19,6 +19,12 @@ module scene_validation
    !> Accepted `&material oscillation_rule=` and `smoothed_variables=` keywords (FOAL1 options).
    character(len=*), parameter, public :: oscillation_rule_keywords(*) = [character(len=3) :: 'OR', 'AND']
    character(len=*), parameter, public :: smoothed_variables_keywords(*) = [character(len=8) :: 'stress', 'pressure']
+   !> Accepted `&material volume_correction=` keywords (docs/volume-conservation.md).
+   character(len=*), parameter, public :: volume_correction_keywords(*) = &
+      [character(len=23) :: 'none', 'shifting', 'eos_relaxation', 'shifting+eos_relaxation']
+   !> Above this shifting coefficient the explicit occupancy diffusion is no longer stable (2-D bilinear
+   !> grid Laplacian, docs/volume-conservation.md).
+   real(rp), parameter :: max_shifting_coefficient = 0.25_rp
    !> Accepted `&run update_scheme=` keywords (stored upper case).
    character(len=*), parameter, public :: update_scheme_keywords(*) = [character(len=4) :: 'USL', 'MUSL']
    !> Accepted `&box_walls` keywords (stored lower case).
@@ -327,6 +333,18 @@ contains
                              quoted_list(smoothed_variables_keywords)//", got '"//trim(material%smoothed_variables)//"'")
          end if
          call check_real(where, 'gamma_max', material%gamma_max, status, at_least=0.0_rp, at_most=1.0_rp)
+         if (all(material%volume_correction /= volume_correction_keywords)) then
+            call status%fail(where//': variable volume_correction must be one of '// &
+                             quoted_list(volume_correction_keywords)//", got '"//trim(material%volume_correction)//"'")
+         else if (material%volume_correction /= 'none' .and. material%model /= model_newtonian_fluid) then
+            call status%fail(where//": variable volume_correction = '"//trim(material%volume_correction)// &
+                             "' is for fluids (model = '"//model_newtonian_fluid//"'), got model = '"// &
+                             trim(material%model)//"'")
+         end if
+         call check_real(where, 'shifting_coefficient', material%shifting_coefficient, status, greater_than=0.0_rp, &
+                         at_most=max_shifting_coefficient)
+         call check_real(where, 'eos_relaxation_rate', material%eos_relaxation_rate, status, greater_than=0.0_rp, &
+                         at_most=1.0_rp)
       end associate
    end subroutine validate_material
 

@@ -15,7 +15,7 @@ module newtonian_fluid
       procedure :: wave_speed => fluid_wave_speed
    end type newtonian_fluid_t
 
-   public :: fluid_point_update
+   public :: fluid_point_update, eos_pressure, eos_density
 
 contains
 
@@ -57,4 +57,18 @@ contains
       real(rp), intent(in) :: density
       fluid_wave_speed = sqrt(self%bulk_modulus / density)
    end function fluid_wave_speed
+
+   !> The equation of state the rate form integrates, p = K ln(rho/rho_0) (dp = -K tr(d) dt, d(ln rho) =
+   !> -tr(d) dt). The code keeps p and rho apart (smoothing acts on the stress); the volume correction
+   !> 'eos_relaxation' pulls p back toward this value (docs/volume-conservation.md).
+   pure real(rp) function eos_pressure(reference_density, bulk_modulus, density) result(pressure)
+      real(rp), intent(in) :: reference_density, bulk_modulus, density
+      pressure = bulk_modulus * log(density / reference_density)
+   end function eos_pressure
+
+   !> Density of the EOS state at pressure p: rho_0 exp(p/K).
+   pure real(rp) function eos_density(reference_density, bulk_modulus, pressure) result(density)
+      real(rp), intent(in) :: reference_density, bulk_modulus, pressure
+      density = reference_density * exp(pressure / bulk_modulus)
+   end function eos_density
 end module newtonian_fluid

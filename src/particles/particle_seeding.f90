@@ -14,6 +14,7 @@ module particle_seeding
    use background_grid, only: grid_t
    use domain_decomposition, only: domain_t
    use particle_set, only: particle_set_t
+   use newtonian_fluid, only: eos_density
    implicit none
    private
 
@@ -49,7 +50,8 @@ contains
       type(particle_set_t), intent(inout) :: particles
       integer :: b, dim, n(3), i, j, l, c(3)
       integer(i8) :: id_offset
-      real(rp) :: spacing(3), x(3), particle_volume, up(3), g_norm, pressure, density, x_grid(3), v_grid(3)
+      real(rp) :: spacing(3), x(3), particle_volume, up(3), g_norm, pressure, density, x_grid(3), v_grid(3), rho
+      logical :: eos_state
       real(rp), allocatable :: sbar(:)
 
       dim = grid%dim
@@ -65,6 +67,8 @@ contains
             spacing(1:dim) = (body%upper(1:dim) - body%lower(1:dim)) / n(1:dim)
             particle_volume = product(spacing(1:dim))
             density = scene%materials(body%material_index)%density
+            ! a fluid whose pressure relaxes toward its EOS starts in an EOS state (docs/volume-conservation.md)
+            eos_state = index(scene%materials(body%material_index)%volume_correction, 'eos_relaxation') > 0
             v_grid = 0.0_rp
             v_grid(1:dim) = grid%frame%grid_vector(body%velocity(1:dim))
             x_grid = 0.0_rp
@@ -76,12 +80,14 @@ contains
                      c = grid%cell_of_position(x_grid(1:dim))
                      if (.not. domain%owns_cell(c(1:dim))) cycle
                      sbar = 0.0_rp
+                     rho = density
                      if (body%hydrostatic) then
-                        ! p = rho0 |g| (depth below the free surface); sbar = -p / rho0 on the normal components
+                        ! p = rho0 |g| (depth below the free surface); sbar = -p / rho on the normal components
                         pressure = density * g_norm * max(0.0_rp, body%free_surface_level - dot_product(up(1:dim), x(1:dim)))
-                        sbar(1:3) = -pressure / density
+                        if (eos_state) rho = eos_density(density, scene%materials(body%material_index)%bulk_modulus, pressure)
+                        sbar(1:3) = -pressure / rho
                      end if
-                     call particles%add(x_grid(1:dim), v_grid(1:dim), density * particle_volume, density, sbar, &
+                     call particles%add(x_grid(1:dim), v_grid(1:dim), density * particle_volume, rho, sbar, &
                                         body%material_index, id_offset + i + int(n(1), i8) * (j + int(n(2), i8) * l))
                   end do
                end do

@@ -40,7 +40,7 @@ module boundary_walls
       integer, allocatable :: nodes(:)     !< local nodes this rank constrains
    end type wall_t
 
-   public :: build_walls, make_wall, set_wall_activity, apply_wall_constraints, keep_particles_inside
+   public :: build_walls, make_wall, set_wall_activity, apply_wall_constraints, keep_particles_inside, behind_wall
 
 contains
 
@@ -141,19 +141,25 @@ contains
    end function make_wall
 
    !> True if the grid-frame point x lies on the wall or behind it (within `tolerance` in front), not
-   !> farther behind than the wall's depth, with its foot point inside the wall's extent.
-   logical function behind_wall(wall, grid, x, tolerance) result(behind)
+   !> farther behind than the wall's depth, with its foot point inside the wall's extent. `widen` [m]
+   !> deepens the depth and widens the extent (whether a ball of that radius about x may touch the wall's
+   !> zone).
+   logical function behind_wall(wall, grid, x, tolerance, widen) result(behind)
       type(wall_t), intent(in) :: wall
       type(grid_t), intent(in) :: grid
       real(rp), intent(in) :: x(:), tolerance
-      real(rp) :: distance, foot(size(x))
+      real(rp), intent(in), optional :: widen
+      real(rp) :: distance, foot(size(x)), extra
       integer :: d
       d = size(x)
+      extra = 0.0_rp
+      if (present(widen)) extra = widen
       distance = dot_product(wall%normal(1:d), x - wall%point(1:d))
-      behind = distance <= tolerance .and. distance >= -wall%depth
+      behind = distance <= tolerance .and. distance >= -(wall%depth + extra)
       if (.not. behind) return
       foot = grid%frame%world_point(x - distance * wall%normal(1:d))
-      behind = all(foot >= wall%lower(1:d) - wall%margin) .and. all(foot <= wall%upper(1:d) + wall%margin)
+      behind = all(foot >= wall%lower(1:d) - (wall%margin + extra)) .and. &
+               all(foot <= wall%upper(1:d) + (wall%margin + extra))
    end function behind_wall
 
    !> Walls act during [active_from, active_until) only.

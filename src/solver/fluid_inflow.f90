@@ -19,6 +19,7 @@ module fluid_inflow
    use domain_decomposition, only: domain_t
    use particle_set, only: particle_set_t
    use boundary_walls, only: wall_t, make_wall, wall_kind_slip, wall_kind_prescribed
+   use newtonian_fluid, only: eos_density
    implicit none
    private
 
@@ -36,6 +37,7 @@ module fluid_inflow
       integer :: across(2) = 1                 !< particles across the opening: along the tangent, along z
       real(rp) :: across_spacing(2) = 1.0_rp   !< their spacing [m]
       real(rp) :: particle_mass = 0.0_rp, density = 0.0_rp
+      real(rp) :: eos_bulk_modulus = 0.0_rp     !< > 0: particles enter in the EOS state of their pressure
       real(rp) :: up(3) = 0.0_rp, gravity_norm = 0.0_rp, stream_top = 0.0_rp
       integer(i8) :: first_id = 0
    contains
@@ -80,6 +82,8 @@ contains
                volume_across = spec%height * spec%width
             end if
             inlet%density = scene%materials(spec%material_index)%density
+            if (index(scene%materials(spec%material_index)%volume_correction, 'eos_relaxation') > 0) &
+               inlet%eos_bulk_modulus = scene%materials(spec%material_index)%bulk_modulus
             ! a layer carries rho0 Dp H (W): the particle masses add up to exactly that
             inlet%particle_mass = inlet%density * inlet%spacing * volume_across / product(inlet%across)
             inlet%first_id = first_id + (i - 1) * ids_per_inlet
@@ -129,7 +133,7 @@ contains
       type(particle_set_t), intent(inout) :: particles
       integer(i8) :: k, first, last
       integer :: a, b, dim, c(3)
-      real(rp) :: length, downstream, x(3), x_grid(3), v_grid(3), pressure
+      real(rp) :: length, downstream, x(3), x_grid(3), v_grid(3), pressure, rho
       real(rp), allocatable :: sbar(:)
 
       created = 0
@@ -152,11 +156,13 @@ contains
                c = grid%cell_of_position(x_grid(1:dim))
                if (.not. domain%owns_cell(c(1:dim))) cycle
                sbar = 0.0_rp
+               rho = self%density
                if (self%spec%hydrostatic) then
                   pressure = self%density * self%gravity_norm * max(0.0_rp, self%stream_top - dot_product(self%up, x))
-                  sbar(1:3) = -pressure / self%density
+                  if (self%eos_bulk_modulus > 0.0_rp) rho = eos_density(self%density, self%eos_bulk_modulus, pressure)
+                  sbar(1:3) = -pressure / rho
                end if
-               call particles%add(x_grid(1:dim), v_grid(1:dim), self%particle_mass, self%density, sbar, &
+               call particles%add(x_grid(1:dim), v_grid(1:dim), self%particle_mass, rho, sbar, &
                                   self%spec%material_index, &
                                   self%first_id + (k - 1) * product(int(self%across, i8)) + a + int(self%across(1), i8) * b)
                created = created + 1

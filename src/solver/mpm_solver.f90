@@ -30,6 +30,7 @@ module mpm_solver
    use newtonian_fluid, only: newtonian_fluid_t
    use stabilizer, only: stabilizer_slot_t, stage_context_t
    use stabilizer_factory, only: build_stabilizers
+   use volume_correction, only: volume_corrector_t, max_shift_in_cells
    use boundary_walls, only: wall_t, build_walls, set_wall_activity, apply_wall_constraints, keep_particles_inside
    use fluid_inflow, only: inlet_t, build_inlets
    use world_frame, only: frame_t, place_grid
@@ -53,6 +54,7 @@ module mpm_solver
       type(particle_set_t) :: particles
       type(material_slot_t), allocatable :: materials(:)
       type(stabilizer_slot_t), allocatable :: schemes(:)
+      type(volume_corrector_t) :: volume        !< fluid volume consistency options (none by default)
       type(wall_t), allocatable :: walls(:)
       type(inlet_t), allocatable :: inlets(:)
       real(rp) :: time = 0.0_rp, dt = 0.0_rp
@@ -112,6 +114,7 @@ contains
       call self%grid%init(self%domain, grid_origin, scene%grid%cell_size, frame)
       call build_materials(scene%materials, self%materials, status)
       if (status%ok) call build_stabilizers(scene%materials, self%schemes, status)
+      call self%volume%init(scene, self%gravity)
       call agree_on_status(status, self%domain%comm)
       if (.not. status%ok) return
       call build_boundaries(self)
@@ -200,6 +203,7 @@ contains
       end if
       call self%grid%init(self%domain, self%grid%origin, self%grid%h, self%grid%frame)
       call build_boundaries(self)
+      call self%volume%reset_grid()
       call update_cells(self%grid, self%particles)
       if (.not. same_owners) call sort_by_material_and_cell(self%grid, self%particles)
       call size_node_arrays(self)
@@ -252,6 +256,7 @@ contains
 
       dt = self%dt
       call set_wall_activity(self%walls, self%time)
+      call self%volume%prepare(self%domain, self%grid, self%walls, self%particles)
       context%domain => self%domain
       context%grid => self%grid
       context%dt = dt
@@ -277,6 +282,12 @@ contains
                                    extent=self%extent)
          end if
       end associate
+      call self%volume%apply_shifts(self%particles)
+      ! the shifts come after the extent was taken: widen it by their largest length
+      if (self%volume%shifting) then
+         self%extent(:, 1) = self%extent(:, 1) - max_shift_in_cells * self%grid%h
+         self%extent(:, 2) = self%extent(:, 2) + max_shift_in_cells * self%grid%h
+      end if
 
       do m = 1, size(self%schemes)
          if (.not. allocated(self%schemes(m)%scheme)) cycle
@@ -296,6 +307,7 @@ contains
          call set_slice(m)
          call self%schemes(m)%scheme%filter_stress(context, self%particles)
       end do
+      call self%volume%relax_pressure(self%particles)
 
       call keep_particles_inside(self%walls, self%grid, self%particles, self%wall_corrections)
       created = 0

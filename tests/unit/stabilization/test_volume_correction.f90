@@ -1,0 +1,247 @@
+!> The fluid volume corrections of docs/volume-conservation.md, on 1, 2 and 4 ranks:
+!>  - shifting does nothing to a tank whose particles fill space as their volumes say (a uniform lattice
+!>    on an aligned grid has occupancy exactly 1: the hat functions' lattice sums are exact), and the run
+!>    equals the uncorrected one;
+!>  - shifting undoes crowding: two overlapping bodies (occupancy 2 where they overlap, yet J = 1, no
+!>    pressure, nothing else moves them) spread until no node is crowded by more than 5 %, with the
+!>    mass kept and no particle outside the box; without the correction the overlap stays;
+!>  - eos_relaxation starts a hydrostatic fluid in its EOS state p = K ln(rho/rho_0) and, at rate 1,
+!>    puts every particle's pressure back on it after each step.
+module test_volume_correction
+   use kinds, only: rp, i8
+   use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_MAX
+   use assertions, only: assertTrue, assertRelativelyEqual
+   use error_status, only: status_t
+   use scene_description, only: scene_t
+   use mpm_solver, only: solver_t
+   use particle_set, only: particle_set_t
+   use particle_sorting, only: set_material_ranges
+   use volume_correction, only: volume_corrector_t
+   use run_diagnostics, only: diagnostics_t
+   use test_scenes, only: water_scene, add_body
+   use input_text, only: real_text
+   implicit none
+   private
+
+   public :: test_shifting_leaves_a_filled_tank_alone, test_shifting_spreads_crowded_particles, &
+             test_eos_relaxation_keeps_the_eos_state, test_shift_takes_the_hydrostatic_pressure
+
+contains
+
+   !> The paper's tank (3.2 m x 6.4 m, half full, h = 0.4 m, 3 x 3 particles per cell), FOAL1, at rest;
+   !> in 3-D a 1.6 m x 1.6 m x 3.2 m tank, half full, 2 x 2 x 2 particles per cell.
+   function tank_scene(correction, dim) result(scene)
+      character(len=*), intent(in) :: correction
+      integer, intent(in) :: dim
+      type(scene_t) :: scene
+      if (dim == 3) then
+         scene = water_scene(3, 0.4_rp, [1.6_rp, 1.6_rp, 3.2_rp], 2.2e9_rp, 10.0_rp)
+         call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [1.6_rp, 1.6_rp, 1.6_rp], 2, .true., 1.6_rp)
+      else
+         scene = water_scene(2, 0.4_rp, [3.2_rp, 6.4_rp, 0.0_rp], 2.2e9_rp, 10.0_rp)
+         call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [3.2_rp, 3.2_rp, 0.0_rp], 3, .true., 3.2_rp)
+      end if
+      scene%materials(1)%stabilization = 'FOAL1'
+      scene%materials(1)%volume_correction = correction
+   end function tank_scene
+
+   subroutine test_shifting_leaves_a_filled_tank_alone(comm)
+      type(MPI_Comm), intent(in) :: comm
+      call check_filled_tank(comm, 2)
+      call check_filled_tank(comm, 3)
+   end subroutine test_shifting_leaves_a_filled_tank_alone
+
+   subroutine check_filled_tank(comm, dim)
+      type(MPI_Comm), intent(in) :: comm
+      integer, intent(in) :: dim
+      type(solver_t) :: plain, shifted
+      type(status_t) :: status
+      type(diagnostics_t) :: dp, ds
+      integer :: step, n
+      real(rp) :: longest
+
+      call plain%init(tank_scene('none', dim), comm, status)
+      call assertTrue(status%ok, 'plain: '//trim(status%message))
+      call shifted%init(tank_scene('shifting', dim), comm, status)
+      call assertTrue(status%ok, 'shifting: '//trim(status%message))
+      longest = 0.0_rp
+      do step = 1, merge(100, 30, dim == 2)
+         call plain%advance()
+         call shifted%advance()
+         n = shifted%particles%count
+         if (n > 0) longest = max(longest, maxval(norm2(shifted%volume%shift(:, 1:n), dim=1)))
+      end do
+      call MPI_Allreduce(MPI_IN_PLACE, longest, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+      call assertTrue(longest <= 1.0e-12_rp * 0.4_rp, 'no shift in a filled tank, got '//real_text(longest)//' m')
+      call assertTrue(longest >= 0.0_rp .and. shifted%volume%shifting, 'the shifting ran')
+      dp = plain%diagnostics()
+      ds = shifted%diagnostics()
+      ! at rest to round-off: the kinetic energies are ~1e-30 J, compare them against the tank's rho g H^2 W / 2
+      call assertTrue(abs(dp%kinetic_energy - ds%kinetic_energy) <= 1.0e-20_rp * 1000 * 10 * 3.2_rp**3 / 2, &
+                      'the same kinetic energy: '//real_text(dp%kinetic_energy)//' and '//real_text(ds%kinetic_energy)//' J')
+      call assertRelativelyEqual(dp%h_eq, ds%h_eq, 1.0e-12_rp, 'the same h_eq')
+      call plain%free()
+      call shifted%free()
+   end subroutine check_filled_tank
+
+   !> A 2 m x 2 m box without gravity: a body filling the lower half and a second one overlapping its
+   !> middle. The particles carry no stress and no velocity, so only the shifting moves them.
+   function crowded_scene(correction) result(scene)
+      character(len=*), intent(in) :: correction
+      type(scene_t) :: scene
+      scene = water_scene(2, 0.1_rp, [2.0_rp, 2.0_rp, 0.0_rp], 2.0e6_rp, 0.0_rp)
+      scene%materials(1)%stabilization = 'FOAL1'
+      scene%materials(1)%volume_correction = correction
+      scene%materials(1)%shifting_coefficient = 0.2_rp
+      call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [2.0_rp, 1.0_rp, 0.0_rp], 2, .false., 0.0_rp)
+      call add_body(scene, 1, [0.5_rp, 0.2_rp, 0.0_rp], [1.5_rp, 0.8_rp, 0.0_rp], 2, .false., 0.0_rp)
+   end function crowded_scene
+
+   subroutine test_shifting_spreads_crowded_particles(comm)
+      type(MPI_Comm), intent(in) :: comm
+      call check_crowding(comm, 'shifting', 1500, spread=.true.)
+      call check_crowding(comm, 'none', 300, spread=.false.)
+   end subroutine test_shifting_spreads_crowded_particles
+
+   subroutine check_crowding(comm, correction, steps, spread)
+      type(MPI_Comm), intent(in) :: comm
+      character(len=*), intent(in) :: correction
+      integer, intent(in) :: steps
+      logical, intent(in) :: spread
+      type(solver_t) :: solver
+      type(status_t) :: status
+      type(diagnostics_t) :: before, after
+      real(rp) :: crowding, outside
+      integer :: step, n
+
+      call solver%init(crowded_scene(correction), comm, status)
+      call assertTrue(status%ok, correction//': '//trim(status%message))
+      before = solver%diagnostics()
+      crowding = largest_crowding(solver, comm)
+      call assertTrue(crowding > 0.9_rp, correction//': the overlap crowds the nodes by ~100 %, got '// &
+                      real_text(100 * crowding)//' %')
+      do step = 1, steps
+         call solver%advance()
+      end do
+      after = solver%diagnostics()
+      crowding = largest_crowding(solver, comm)
+      if (spread) then
+         call assertTrue(crowding < 0.05_rp, correction//': largest crowding after '//real_text(real(steps, rp))// &
+                         ' steps below 5 %, got '//real_text(100 * crowding)//' %')
+      else
+         call assertTrue(crowding > 0.9_rp, correction//': the overlap stays, got '//real_text(100 * crowding)//' %')
+      end if
+      call assertRelativelyEqual(before%total_mass, after%total_mass, 1.0e-14_rp, correction//': mass kept')
+      n = solver%particles%count
+      outside = 0.0_rp
+      if (n > 0) outside = max(0.0_rp, -minval(solver%particles%x(:, 1:n)), maxval(solver%particles%x(:, 1:n)) - 2.0_rp)
+      call MPI_Allreduce(MPI_IN_PLACE, outside, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+      call assertTrue(outside <= 0.0_rp, correction//': no particle outside the box')
+      call solver%free()
+   end subroutine check_crowding
+
+   !> max_i (phi_i - 1) over the nodes, the occupancy measured with the corrector's own open volumes but
+   !> here from the particles directly: sum_p N_ip V_p / V_i (V_i = h^2, h^2/2, h^2/4 in the box).
+   real(rp) function largest_crowding(solver, comm) result(largest)
+      type(solver_t), intent(inout) :: solver
+      type(MPI_Comm), intent(in) :: comm
+      real(rp), allocatable :: occupancy(:)
+      real(rp) :: xi(2), n(4), open_volume
+      integer :: p, c(2), a, k, node, corner(2), g(2)
+      associate (grid => solver%grid, particles => solver%particles)
+         allocate (occupancy(grid%node_count))
+         occupancy = 0.0_rp
+         do p = 1, particles%count
+            do k = 1, 2
+               xi(k) = particles%x(k, p) * grid%inv_h
+               c(k) = min(floor(xi(k)), grid%global_cells(k) - 1)
+               xi(k) = xi(k) - c(k)
+            end do
+            do a = 1, 4
+               corner = [mod(a - 1, 2), (a - 1) / 2]
+               n(a) = product(merge(xi, 1.0_rp - xi, corner == 1))
+               node = grid%local_node(c + corner)
+               occupancy(node) = occupancy(node) + n(a) * particles%mass(p) / particles%density(p)
+            end do
+         end do
+         ! nodes on a rank boundary: only their own particles' share here, so look at interior nodes of the
+         ! rank and the box walls (a crowded spot several cells wide is seen by either rank)
+         largest = 0.0_rp
+         do node = 1, grid%node_count
+            g = [grid%node_lo(1) + mod(node - 1, grid%n_nodes(1)), grid%node_lo(2) + (node - 1) / grid%n_nodes(1)]
+            if (any((g == grid%node_lo(1:2) .or. g == grid%node_hi(1:2)) .and. &
+                    g /= 0 .and. g /= grid%global_cells(1:2))) cycle
+            open_volume = grid%h**2
+            do k = 1, 2
+               if (g(k) == 0 .or. g(k) == grid%global_cells(k)) open_volume = open_volume / 2
+            end do
+            largest = max(largest, occupancy(node) / open_volume - 1.0_rp)
+         end do
+      end associate
+      call MPI_Allreduce(MPI_IN_PLACE, largest, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+   end function largest_crowding
+
+   subroutine test_eos_relaxation_keeps_the_eos_state(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(solver_t) :: solver
+      type(status_t) :: status
+      type(scene_t) :: scene
+      real(rp) :: worst
+      integer :: step
+
+      scene = tank_scene('eos_relaxation', 2)
+      scene%materials(1)%stabilization = 'FOAL1'
+      scene%materials(1)%eos_relaxation_rate = 1.0_rp
+      call solver%init(scene, comm, status)
+      call assertTrue(status%ok, trim(status%message))
+      worst = eos_mismatch(solver, comm)
+      call assertTrue(worst <= 1.0e-5_rp, 'seeded in the EOS state: largest |p - K ln(rho/rho0)| = '// &
+                      real_text(worst)//' Pa')
+      do step = 1, 20
+         call solver%advance()
+      end do
+      worst = eos_mismatch(solver, comm)
+      call assertTrue(worst <= 1.0e-5_rp, 'on the EOS after each step at rate 1: largest mismatch '// &
+                      real_text(worst)//' Pa')
+      call solver%free()
+   end subroutine test_eos_relaxation_keeps_the_eos_state
+
+   !> A particle shifted by dx in a fluid at rest takes the pressure of its new place: p + rho g . dx
+   !> (down by 1 cm under g = 10: +100 Pa at rho = 1000), the deviatoric stress and shear untouched.
+   subroutine test_shift_takes_the_hydrostatic_pressure(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(volume_corrector_t) :: corrector
+      type(particle_set_t) :: particles
+      real(rp) :: sbar(4), pressure
+      call corrector%init(tank_scene('shifting', 2), [0.0_rp, -10.0_rp, 0.0_rp])
+      call particles%init(2, 1, 4)
+      sbar = [-2.0_rp, -2.0_rp, -2.0_rp, 0.5_rp]            ! p = 2000 Pa at rho = 1000, a shear of 500 Pa
+      call particles%add([1.0_rp, 1.0_rp], [0.0_rp, 0.0_rp], 1.0_rp, 1000.0_rp, sbar, 1, 1_i8)
+      call set_material_ranges(particles)
+      allocate (corrector%shift(2, 1))
+      corrector%shift(:, 1) = [0.003_rp, -0.01_rp]
+      call corrector%apply_shifts(particles)
+      pressure = -1000.0_rp * sum(particles%sbar(1:3, 1)) / 3.0_rp
+      ! every rank does the same: the largest pressure over the ranks is the one to check
+      call MPI_Allreduce(MPI_IN_PLACE, pressure, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+      call assertRelativelyEqual(2100.0_rp, pressure, 1.0e-12_rp, 'pressure 1 cm deeper')
+      call assertRelativelyEqual(0.5_rp, particles%sbar(4, 1), 1.0e-15_rp, 'shear kept')
+      call assertRelativelyEqual(1.003_rp, particles%x(1, 1), 1.0e-15_rp, 'moved along x')
+      call assertRelativelyEqual(0.99_rp, particles%x(2, 1), 1.0e-15_rp, 'moved along y')
+   end subroutine test_shift_takes_the_hydrostatic_pressure
+
+   real(rp) function eos_mismatch(solver, comm) result(worst)
+      type(solver_t), intent(in) :: solver
+      type(MPI_Comm), intent(in) :: comm
+      integer :: p
+      real(rp) :: pressure
+      worst = 0.0_rp
+      associate (particles => solver%particles)
+         do p = 1, particles%count
+            pressure = -particles%density(p) * sum(particles%sbar(1:3, p)) / 3.0_rp
+            worst = max(worst, abs(pressure - 2.2e9_rp * log(particles%density(p) / 1000.0_rp)))
+         end do
+      end associate
+      call MPI_Allreduce(MPI_IN_PLACE, worst, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+   end function eos_mismatch
+end module test_volume_correction
