@@ -2,6 +2,8 @@
 !> number of steps without output and prints one line of figures (scripts/bench collects them):
 !>   dim ranks particles steps seconds particle_steps_per_s_per_core bytes_per_particle peak_bytes
 !>   grid_nodes layouts cpu_seconds
+!> preceded by a line of the timed steps' wall time per phase (phase_timers; the slowest rank's):
+!>   phases <name>=<seconds> ...
 !> Memory per particle is the growth of the resident set from before the solver is built to after the
 !> timed steps, divided by the rank's particles (rank 0's view); peak_bytes the largest resident set
 !> of a rank (VmHWM); grid_nodes the nodes of all ranks' grids at the end; layouts how often the
@@ -29,6 +31,7 @@ program flotsam_bench
    use health_check, only: particles_healthy
    use simulation, only: blow_up_speed
    use process_memory, only: resident_bytes, peak_resident_bytes
+   use phase_timers, only: phase_names, phase_rebalance, phase_other
    implicit none
 
    type(scene_t) :: scene
@@ -72,7 +75,9 @@ program flotsam_bench
       call advance()
    end do
    call MPI_Barrier(MPI_COMM_WORLD)
+   call solver%timers%reset()
    t0 = MPI_Wtime()
+   call solver%timers%switch_to(phase_other)
    call cpu_time(cpu0)
    do step = 1, steps
       call advance()
@@ -80,10 +85,12 @@ program flotsam_bench
    call cpu_time(cpu1)
    call MPI_Barrier(MPI_COMM_WORLD)
    t1 = MPI_Wtime()
+   call solver%timers%switch_to(phase_other)
    cpu = cpu1 - cpu0
    call MPI_Allreduce(MPI_IN_PLACE, cpu, 1, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
    rss_after = real(resident_bytes(), rp)
    diag = solver%diagnostics()
+   call print_phases()
    peak = peak_resident_bytes()
    call MPI_Allreduce(MPI_IN_PLACE, peak, 1, MPI_INTEGER8, MPI_MAX, MPI_COMM_WORLD)
    nodes = solver%grid%node_count
@@ -100,9 +107,26 @@ contains
    !> A step and, as in the time loop, the balance check every rebalance_interval steps.
    subroutine advance()
       call solver%advance()
-      if (mod(solver%step, int(scene%run%rebalance_interval, i8)) == 0) call solver%balance_load(status)
+      if (mod(solver%step, int(scene%run%rebalance_interval, i8)) == 0) then
+         call solver%timers%switch_to(phase_rebalance)
+         call solver%balance_load(status)
+         call solver%timers%switch_to(phase_other)
+      end if
       if (.not. status%ok) call bench_failure()
    end subroutine advance
+
+   !> The `phases` line: each phase's seconds over the timed steps, the largest over the ranks.
+   subroutine print_phases()
+      real(rp) :: largest(size(phase_names))
+      integer :: k
+      call MPI_Allreduce(solver%timers%seconds, largest, size(largest), MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
+      if (rank /= 0) return
+      write (output_unit, '(a)', advance='no') 'phases'
+      do k = 1, size(phase_names)
+         write (output_unit, '(1x,a,"=",es10.3)', advance='no') trim(phase_names(k)), largest(k)
+      end do
+      write (output_unit, '(a)') ''
+   end subroutine print_phases
 
    !> Time the output of the current state: fields file, checkpoint, health check (see the header).
    subroutine time_output(step_seconds)

@@ -100,7 +100,7 @@ module scene_description
       logical :: cell_averaging = .true.      !< FOAL1: replace particle values by the cell average first
       !> Fluid volume consistency (docs/volume-conservation.md): 'none', 'shifting' or 'eos_relaxation'
       character(len=name_len) :: volume_correction = 'none'
-      real(rp) :: shifting_coefficient = 0.05_rp   !< shifting: D in dx = -D h^2 grad(excess occupancy), per step
+      real(rp) :: shifting_coefficient = 0.02_rp   !< shifting: D in dx = -D h^2 grad(excess occupancy), per step
       real(rp) :: eos_relaxation_rate = 0.01_rp    !< eos_relaxation: fraction of p - p_EOS(rho) removed per step
    end type material_spec_t
 

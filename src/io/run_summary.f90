@@ -3,10 +3,13 @@
 !>   wall_seconds, steps, particle_steps, particle_steps_per_second_per_core, ranks,
 !>   peak_memory_bytes (largest rank), peak_memory_bytes_total (all ranks), outcome
 !> Steps and particle-steps count this invocation only (a restarted run reports its continuation).
+!> `timing.csv` beside it: the time loop's wall time per phase (phase_timers), one row per phase:
+!>   phase, seconds_max (the slowest rank's), seconds_mean (over the ranks), share (of the mean loop time)
+!> and a last row `total` (seconds_max: the largest of the ranks' sums, not the sum of the maxima).
 module run_summary
    use kinds, only: rp, i8
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_Comm_rank, MPI_Comm_size, MPI_IN_PLACE, MPI_INTEGER8, &
-                      MPI_SUM, MPI_MAX
+                      MPI_DOUBLE_PRECISION, MPI_SUM, MPI_MAX
    use error_status, only: status_t
    use process_memory, only: peak_resident_bytes
    use input_text, only: int_text, real_text
@@ -15,9 +18,9 @@ module run_summary
    implicit none
    private
 
-   character(len=*), parameter, public :: run_summary_file = 'run_summary.csv'
+   character(len=*), parameter, public :: run_summary_file = 'run_summary.csv', timing_file = 'timing.csv'
 
-   public :: write_run_summary
+   public :: write_run_summary, write_timing
 
 contains
 
@@ -30,8 +33,7 @@ contains
       integer(i8), intent(in) :: steps, local_particle_steps
       type(status_t), intent(inout) :: status
       integer(i8) :: particle_steps, peak(1), total(1)
-      integer :: rank, ranks, unit, ios
-      character(len=256) :: message
+      integer :: rank, ranks, unit
       real(rp) :: rate
 
       call MPI_Comm_rank(comm, rank)
@@ -45,18 +47,63 @@ contains
       if (rank /= 0) return
       rate = 0.0_rp
       if (wall_seconds > 0.0_rp) rate = real(particle_steps, rp) / (wall_seconds * ranks)
-      open (newunit=unit, file=dir//'/'//run_summary_file//temporary_suffix, status='replace', action='write', &
-            iostat=ios, iomsg=message)
-      if (ios /= 0) then
-         call status%fail('cannot write '//dir//'/'//run_summary_file//': '//trim(message))
-         return
-      end if
+      if (.not. opened(dir, run_summary_file, unit, status)) return
       write (unit, '(a)') 'wall_seconds,steps,particle_steps,particle_steps_per_second_per_core,ranks,'// &
          'peak_memory_bytes,peak_memory_bytes_total,outcome'
       write (unit, '(a)') real_text(wall_seconds)//','//int_text(steps)//','//int_text(particle_steps)//','// &
          real_text(rate)//','//int_text(ranks)//','//int_text(peak(1))//','//int_text(total(1))//','//outcome
-      close (unit)
-      if (.not. rename_path(dir//'/'//run_summary_file//temporary_suffix, dir//'/'//run_summary_file)) &
-         call status%fail('cannot rename '//dir//'/'//run_summary_file//temporary_suffix)
+      call publish(dir, run_summary_file, unit, status)
    end subroutine write_run_summary
+
+   !> Collective over `comm`: rank 0 writes <dir>/timing.csv (replacing it) from every rank's `seconds`
+   !> of the phases `names`.
+   subroutine write_timing(dir, comm, seconds, names, status)
+      character(len=*), intent(in) :: dir
+      type(MPI_Comm), intent(in) :: comm
+      real(rp), intent(in) :: seconds(:)
+      character(len=*), intent(in) :: names(:)
+      type(status_t), intent(inout) :: status
+      real(rp) :: largest(size(seconds)), mean(size(seconds)), total, largest_total
+      integer :: rank, ranks, unit, k
+
+      call MPI_Comm_rank(comm, rank)
+      call MPI_Comm_size(comm, ranks)
+      call MPI_Allreduce(seconds, largest, size(seconds), MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+      call MPI_Allreduce(seconds, mean, size(seconds), MPI_DOUBLE_PRECISION, MPI_SUM, comm)
+      call MPI_Allreduce(sum(seconds), largest_total, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+      if (rank /= 0) return
+      mean = mean / ranks
+      total = sum(mean)
+      if (.not. opened(dir, timing_file, unit, status)) return
+      write (unit, '(a)') 'phase,seconds_max,seconds_mean,share'
+      do k = 1, size(seconds)
+         write (unit, '(a)') trim(names(k))//','//real_text(largest(k))//','//real_text(mean(k))//','// &
+            real_text(merge(mean(k) / total, 0.0_rp, total > 0.0_rp))
+      end do
+      write (unit, '(a)') 'total,'//real_text(largest_total)//','//real_text(total)//',1'
+      call publish(dir, timing_file, unit, status)
+   end subroutine write_timing
+
+   !> Open <dir>/<name>.tmp for writing as `unit`; false (and status failed) if it cannot be.
+   logical function opened(dir, name, unit, status)
+      character(len=*), intent(in) :: dir, name
+      integer, intent(out) :: unit
+      type(status_t), intent(inout) :: status
+      integer :: ios
+      character(len=256) :: message
+      open (newunit=unit, file=dir//'/'//name//temporary_suffix, status='replace', action='write', iostat=ios, &
+            iomsg=message)
+      opened = ios == 0
+      if (.not. opened) call status%fail('cannot write '//dir//'/'//name//': '//trim(message))
+   end function opened
+
+   !> Close `unit` and rename <dir>/<name>.tmp to its final name (the file is complete).
+   subroutine publish(dir, name, unit, status)
+      character(len=*), intent(in) :: dir, name
+      integer, intent(in) :: unit
+      type(status_t), intent(inout) :: status
+      close (unit)
+      if (.not. rename_path(dir//'/'//name//temporary_suffix, dir//'/'//name)) &
+         call status%fail('cannot rename '//dir//'/'//name//temporary_suffix)
+   end subroutine publish
 end module run_summary

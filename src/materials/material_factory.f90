@@ -34,6 +34,7 @@ contains
             solid%name = specs(m)%name
             solid%reference_density = specs(m)%density
             solid%is_fluid = .false.
+            solid%uses_spin = .true.       ! the Jaumann rate
             call solid%set_from_young_poisson(specs(m)%youngs_modulus, specs(m)%poisson_ratio)
             allocate (materials(m)%model, source=solid)
          case default

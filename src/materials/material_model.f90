@@ -10,6 +10,7 @@ module material_model
       character(len=name_len) :: name = ''
       real(rp) :: reference_density = 0.0_rp
       logical :: is_fluid = .false.     !< counts towards the fluid volume and h_eq
+      logical :: uses_spin = .false.    !< its update_stress reads the spin (else the step does not compute it)
    contains
       procedure(update_stress_interface), deferred :: update_stress
       procedure(wave_speed_interface), deferred :: wave_speed
@@ -18,7 +19,8 @@ module material_model
 
    abstract interface
       !> Advance density and mass-specific stress of a slice of particles over dt with the (filtered)
-      !> rate of deformation d~ and spin w (algorithms.md section 1.2, step 5).
+      !> rate of deformation d~ and spin w (algorithms.md section 1.2, step 5). The spin is computed
+      !> only for a model with uses_spin; other models must not read it.
       subroutine update_stress_interface(self, dim, dt, strain_rate, spin, density, sbar)
          import :: material_model_t, rp
          class(material_model_t), intent(in) :: self

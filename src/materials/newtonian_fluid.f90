@@ -29,9 +29,15 @@ contains
       ! The spin is not used: the pressure is isotropic and the viscous stress is recomputed from d~
       ! every step, so neither has a Jaumann rotation term.
       if (size(spin) < 0) return
-      do p = 1, size(density)
-         call fluid_point_update(self%bulk_modulus, self%viscosity, dim, dt, strain_rate(:, p), density(p), sbar(:, p))
-      end do
+      if (self%viscosity > 0.0_rp) then
+         do p = 1, size(density)
+            call fluid_point_update(self%bulk_modulus, self%viscosity, dim, dt, strain_rate(:, p), density(p), sbar(:, p))
+         end do
+      else
+         do p = 1, size(density)
+            call inviscid_point_update(self%bulk_modulus, dim, dt, strain_rate(:, p), density(p), sbar(:, p))
+         end do
+      end if
    end subroutine fluid_update_stress
 
    !> One particle: update density and mass-specific stress sbar = sigma / rho.
@@ -51,6 +57,28 @@ contains
       sbar(n_normal + 1:) = two_mu * d(n_normal + 1:) / new_density
       density = new_density
    end subroutine fluid_point_update
+
+   !> fluid_point_update with viscosity 0, bit for bit, without the viscous terms: -p + 0 dev(d) is -p
+   !> unless p = 0 (then the zero's sign is dev(d)'s), and 0 d / rho is a zero with the sign of d.
+   !> One division for the normal components instead of three, none for the shear.
+   pure subroutine inviscid_point_update(bulk_modulus, dim, dt, d, density, sbar)
+      real(rp), intent(in) :: bulk_modulus, dt, d(:)
+      integer, intent(in) :: dim
+      real(rp), intent(inout) :: density, sbar(:)
+      real(rp) :: pressure, trace_d, new_density, normal
+      pressure = -density * (sbar(1) + sbar(2) + sbar(3)) / 3.0_rp
+      trace_d = d(1) + d(2) + d(3)
+      pressure = pressure - bulk_modulus * trace_d * dt
+      new_density = density / volume_ratio_increment(dim, dt, d)
+      if (abs(pressure) > 0.0_rp) then
+         normal = -pressure / new_density
+         sbar(1:3) = normal
+      else
+         sbar(1:3) = (-pressure + 0.0_rp * (d(1:3) - trace_d / 3.0_rp)) / new_density
+      end if
+      sbar(4:) = sign(0.0_rp, d(4:))
+      density = new_density
+   end subroutine inviscid_point_update
 
    pure real(rp) function fluid_wave_speed(self, density)
       class(newtonian_fluid_t), intent(in) :: self

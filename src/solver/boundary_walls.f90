@@ -212,11 +212,18 @@ contains
       type(particle_set_t), intent(inout) :: particles
       integer, intent(inout) :: corrections
       integer :: w, p, d
-      real(rp) :: distance, vn
+      real(rp) :: distance, vn, lowest(3), highest(3)
       d = particles%dim
+      if (.not. any(walls%active)) return
+      call position_bounds(particles, lowest, highest)
       do w = 1, size(walls)
          if (.not. walls(w)%active) cycle
          if (walls(w)%axis > 0) then
+            ! no particle behind it: skip the pass (the usual case; x - x0 is monotonic in x)
+            associate (k => walls(w)%axis)
+               if (walls(w)%normal(k) > 0.0_rp .and. lowest(k) - walls(w)%point(k) >= 0.0_rp) cycle
+               if (walls(w)%normal(k) < 0.0_rp .and. highest(k) - walls(w)%point(k) <= 0.0_rp) cycle
+            end associate
             call keep_inside_axis_wall(walls(w), grid, particles, corrections)
             cycle
          end if
@@ -233,6 +240,22 @@ contains
          end associate
       end do
    end subroutine keep_particles_inside
+
+   !> Smallest and largest particle coordinate along each axis (one pass that vectorises; huge / -huge
+   !> without particles).
+   subroutine position_bounds(particles, lowest, highest)
+      type(particle_set_t), intent(in) :: particles
+      real(rp), intent(out) :: lowest(3), highest(3)
+      integer :: p, k
+      lowest = huge(1.0_rp)
+      highest = -huge(1.0_rp)
+      do p = 1, particles%count
+         do k = 1, particles%dim
+            lowest(k) = min(lowest(k), particles%x(k, p))
+            highest(k) = max(highest(k), particles%x(k, p))
+         end do
+      end do
+   end subroutine position_bounds
 
    !> The safeguard for a wall normal to grid axis k: the same operation without the dot products.
    subroutine keep_inside_axis_wall(wall, grid, particles, corrections)

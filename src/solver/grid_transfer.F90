@@ -10,7 +10,7 @@ module grid_transfer
    implicit none
    private
 
-   public :: particles_to_grid, update_velocity_and_remap, grid_to_particles
+   public :: particles_to_grid, update_velocity_and_remap, grid_to_particles, volume_to_grid, gradient_at_particles
 
 contains
 
@@ -48,25 +48,30 @@ contains
    !>   v_p := alpha (v_p + sum N dv_i) + (1 - alpha) sum N v_i^{n+1}                  (if update_velocity)
    !>   x_p := x_p + dt sum N v_i^{n+theta}                                             (if update_position)
    !> `strain_velocity`, when present, replaces v^{n+theta} in L (MUSL: the re-mapped velocities).
+   !> `compute_spin` (default: as compute_strain) = .false. leaves the spin alone: only solids use it.
    !> `extent` returns the lowest (:, 1) and highest (:, 2) new position along each axis (with
    !> update_position; 0 beyond dim): the active region's check needs it, and here it costs no pass.
    subroutine grid_to_particles(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
-                                update_position, strain_velocity, extent)
+                                update_position, strain_velocity, compute_spin, extent)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
       real(rp), intent(in) :: dt, flip_fraction, theta
       logical, intent(in) :: update_velocity, compute_strain, update_position
       real(rp), intent(in), optional :: strain_velocity(:, :)
+      logical, intent(in), optional :: compute_spin
       real(rp), intent(out), optional :: extent(3, 2)
       real(rp) :: lo(3), hi(3)
+      logical :: spin
+      spin = compute_strain
+      if (present(compute_spin)) spin = compute_strain .and. compute_spin
       lo = 0.0_rp
       hi = 0.0_rp
       if (grid%dim == 2) then
          call grid_to_particles_2d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
-                                   update_position, lo(1:2), hi(1:2), strain_velocity)
+                                   spin, update_position, lo(1:2), hi(1:2), strain_velocity)
       else
          call grid_to_particles_3d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
-                                   update_position, lo, hi, strain_velocity)
+                                   spin, update_position, lo, hi, strain_velocity)
       end if
       if (present(extent)) then
          extent(:, 1) = lo
@@ -74,12 +79,42 @@ contains
       end if
    end subroutine grid_to_particles
 
+   !> o_i += sum_p N_ip m_p / rho_p over all particles (src/stabilization/volume_correction.f90).
+   subroutine volume_to_grid(grid, particles, occupancy)
+      type(grid_t), intent(in) :: grid
+      type(particle_set_t), intent(in) :: particles
+      real(rp), intent(inout) :: occupancy(:)
+      if (grid%dim == 2) then
+         call volume_to_grid_2d(grid, particles, occupancy)
+      else
+         call volume_to_grid_3d(grid, particles, occupancy)
+      end if
+   end subroutine volume_to_grid
+
+   !> gradient(:, p) = sum_a grad N_a(x_p) field_a for p = first..last at x^n; a node that is not `known`
+   !> takes the N-weighted mean of the particle's known corners.
+   subroutine gradient_at_particles(grid, particles, first, last, field, known, gradient)
+      type(grid_t), intent(in) :: grid
+      type(particle_set_t), intent(in) :: particles
+      integer, intent(in) :: first, last
+      real(rp), intent(in) :: field(:)
+      logical, intent(in) :: known(:)
+      real(rp), intent(inout) :: gradient(:, :)
+      if (grid%dim == 2) then
+         call gradient_at_particles_2d(grid, particles, first, last, field, known, gradient)
+      else
+         call gradient_at_particles_3d(grid, particles, first, last, field, known, gradient)
+      end if
+   end subroutine gradient_at_particles
+
 #define KERNEL_DIM 2
 #define SHAPE shape_2d
 #define LOCATE locate_2d
 #define P2G particles_to_grid_2d
 #define M2G momentum_to_grid_2d
 #define G2P grid_to_particles_2d
+#define V2G volume_to_grid_2d
+#define GRAD2P gradient_at_particles_2d
 #include "../grid/multilinear_shape.inc"
 #include "grid_transfer_kernels.inc"
 #undef KERNEL_DIM
@@ -88,6 +123,8 @@ contains
 #undef P2G
 #undef M2G
 #undef G2P
+#undef V2G
+#undef GRAD2P
 
 #define KERNEL_DIM 3
 #define SHAPE shape_3d
@@ -95,6 +132,8 @@ contains
 #define P2G particles_to_grid_3d
 #define M2G momentum_to_grid_3d
 #define G2P grid_to_particles_3d
+#define V2G volume_to_grid_3d
+#define GRAD2P gradient_at_particles_3d
 #include "../grid/multilinear_shape.inc"
 #include "grid_transfer_kernels.inc"
 end module grid_transfer

@@ -39,6 +39,10 @@ module mpm_solver
    use active_region, only: scene_extent, particle_extent, cells_of_extent, guard_cells, box_needs_change, target_box, &
                             slack_cells
    use status_broadcast, only: agree_on_status
+   use phase_timers, only: phase_timers_t, phase_particles_to_grid, phase_grid_update, phase_walls, &
+                           phase_stabilization, phase_grid_to_particles, phase_constitutive, phase_inflow, &
+                           phase_halo, phase_migration, phase_sort, phase_time_step, phase_volume_correction, &
+                           phase_other
    implicit none
    private
 
@@ -66,6 +70,7 @@ module mpm_solver
       real(rp), allocatable :: remapped_momentum(:, :)
       real(rp) :: extent(3, 2) = 0.0_rp         !< lowest and highest particle position after the last move
       integer :: relayouts = 0                  !< layouts made because the particles outgrew the active region
+      type(phase_timers_t) :: timers            !< wall time per phase (the time loop adds its own phases)
    contains
       procedure :: init => solver_init
       procedure :: advance => solver_advance
@@ -253,47 +258,73 @@ contains
       integer :: m, first, last, arrived, created, i
       real(rp) :: dt
       type(stage_context_t) :: context
+      logical :: smoothed(size(self%schemes)), spin_needed
 
       dt = self%dt
+      call self%timers%switch_to(phase_walls)
       call set_wall_activity(self%walls, self%time)
-      call self%volume%prepare(self%domain, self%grid, self%walls, self%particles)
+      if (self%volume%shifting) then
+         call self%timers%switch_to(phase_volume_correction)
+         call self%volume%prepare(self%domain, self%grid, self%walls, self%particles, self%step)
+      end if
       context%domain => self%domain
       context%grid => self%grid
       context%dt = dt
+      ! a scheme of a material no body or opened inlet supplies has no particles on any rank: skip it (its
+      ! halo exchange and cell scans); a supplied one runs on every rank, with or without particles there
+      do m = 1, size(self%schemes)
+         smoothed(m) = allocated(self%schemes(m)%scheme)
+         if (smoothed(m)) smoothed(m) = material_supplied(self, m)
+      end do
+      ! the spin only for the solids (local: the stress update is)
+      spin_needed = .false.
+      do m = 1, size(self%materials)
+         if (self%materials(m)%model%uses_spin .and. self%particles%material_last(m) >= self%particles%material_first(m)) &
+            spin_needed = .true.
+      end do
+      call self%timers%switch_to(phase_particles_to_grid)
       call particles_to_grid(self%grid, self%particles, self%gravity)
+      call self%timers%switch_to(phase_halo)
       call sum_shared_nodes(self%domain, self%grid, self%grid%accumulated)
+      call self%timers%switch_to(phase_grid_update)
       call update_nodes(self, dt)
 
+      call self%timers%switch_to(phase_stabilization)
       do m = 1, size(self%schemes)
-         if (.not. allocated(self%schemes(m)%scheme)) cycle
+         if (.not. smoothed(m)) cycle
          call set_slice(m)
          call self%schemes(m)%scheme%prepare(context, self%particles)
       end do
 
+      call self%timers%switch_to(phase_grid_to_particles)
       associate (run => self%run)
          if (self%musl) then
             call remap_velocities(self)
             call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
                                    update_velocity=.false., compute_strain=.true., update_position=.true., &
-                                   strain_velocity=self%remapped_momentum, extent=self%extent)
+                                   strain_velocity=self%remapped_momentum, compute_spin=spin_needed, &
+                                   extent=self%extent)
          else
             call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
                                    update_velocity=.true., compute_strain=.true., update_position=.true., &
-                                   extent=self%extent)
+                                   compute_spin=spin_needed, extent=self%extent)
          end if
       end associate
-      call self%volume%apply_shifts(self%particles)
-      ! the shifts come after the extent was taken: widen it by their largest length
-      if (self%volume%shifting) then
+      if (self%volume%shifting_now) then
+         call self%timers%switch_to(phase_volume_correction)
+         call self%volume%apply_shifts(self%particles)
+         ! the shifts come after the extent was taken: widen it by their largest length
          self%extent(:, 1) = self%extent(:, 1) - max_shift_in_cells * self%grid%h
          self%extent(:, 2) = self%extent(:, 2) + max_shift_in_cells * self%grid%h
       end if
 
+      call self%timers%switch_to(phase_stabilization)
       do m = 1, size(self%schemes)
-         if (.not. allocated(self%schemes(m)%scheme)) cycle
+         if (.not. smoothed(m)) cycle
          call set_slice(m)
          call self%schemes(m)%scheme%filter_strain_rate(context, self%particles)
       end do
+      call self%timers%switch_to(phase_constitutive)
       do m = 1, size(self%materials)
          first = self%particles%material_first(m)
          last = self%particles%material_last(m)
@@ -302,19 +333,27 @@ contains
                                                    self%particles%spin(:, first:last), &
                                                    self%particles%density(first:last), self%particles%sbar(:, first:last))
       end do
+      call self%timers%switch_to(phase_stabilization)
       do m = 1, size(self%schemes)
-         if (.not. allocated(self%schemes(m)%scheme)) cycle
+         if (.not. smoothed(m)) cycle
          call set_slice(m)
          call self%schemes(m)%scheme%filter_stress(context, self%particles)
       end do
-      call self%volume%relax_pressure(self%particles)
+      if (self%volume%active()) then
+         call self%timers%switch_to(phase_volume_correction)
+         call self%volume%relax_pressure(self%particles)
+      end if
 
+      call self%timers%switch_to(phase_walls)
       call keep_particles_inside(self%walls, self%grid, self%particles, self%wall_corrections)
+      call self%timers%switch_to(phase_inflow)
       created = 0
       do i = 1, size(self%inlets)
          created = created + self%inlets(i)%inject(self%time, self%time + dt, self%grid, self%domain, self%particles)
       end do
+      call self%timers%switch_to(phase_migration)
       call migrate_particles(self%domain, self%grid, self%particles, self%lost_particles, arrived)
+      call self%timers%switch_to(phase_sort)
       ! arrivals and new particles are appended at the end: re-sort so materials stay contiguous;
       ! otherwise re-sort now and then for memory locality (removals keep the grouping of the rest)
       if (arrived > 0 .or. created > 0 .or. mod(self%step + 1, int(sort_interval, i8)) == 0) then
@@ -325,7 +364,9 @@ contains
 
       self%time = self%time + dt
       self%step = self%step + 1
+      call self%timers%switch_to(phase_time_step)
       call follow_particles(self)
+      call self%timers%switch_to(phase_other)
 
    contains
 
@@ -335,6 +376,20 @@ contains
          context%last = self%particles%material_last(material)
       end subroutine set_slice
    end subroutine solver_advance
+
+   !> True if material m may have particles on some rank now: a body of it, or an inlet of it that has
+   !> opened. The same on every rank (scene and time only), so collective stages can be skipped by it.
+   !> A material whose particles all left through open sides still counts (the scheme then just idles).
+   logical function material_supplied(self, m) result(supplied)
+      type(solver_t), intent(in) :: self
+      integer, intent(in) :: m
+      integer :: i
+      supplied = .false.
+      if (allocated(self%scene%bodies)) supplied = any(self%scene%bodies%material_index == m)
+      do i = 1, size(self%inlets)
+         if (self%inlets(i)%spec%material_index == m .and. self%time >= self%inlets(i)%spec%start_time) supplied = .true.
+      end do
+   end function material_supplied
 
    !> Step 2: v^n = P/m, v^{n+1} = v^n + dt f/m, walls, dv = v^{n+1} - v^n (contains the wall correction).
    subroutine update_nodes(self, dt)
@@ -356,7 +411,9 @@ contains
                v(:, i) = 0.0_rp
             end if
          end do
+         call self%timers%switch_to(phase_walls)
          call apply_wall_constraints(self%walls, dim, v)
+         call self%timers%switch_to(phase_grid_update)
          dv = v - dv
       end associate
    end subroutine update_nodes
@@ -367,7 +424,9 @@ contains
       integer :: i
       real(rp) :: m
       call update_velocity_and_remap(self%grid, self%particles, self%run%flip_fraction, self%remapped_momentum)
+      call self%timers%switch_to(phase_halo)
       call sum_shared_nodes(self%domain, self%grid, self%remapped_momentum)
+      call self%timers%switch_to(phase_grid_to_particles)
       do i = 1, self%grid%node_count
          m = self%grid%accumulated(row_mass, i)
          if (m > self%mass_tolerance) then
@@ -376,7 +435,9 @@ contains
             self%remapped_momentum(:, i) = 0.0_rp
          end if
       end do
+      call self%timers%switch_to(phase_walls)
       call apply_wall_constraints(self%walls, self%grid%dim, self%remapped_momentum)
+      call self%timers%switch_to(phase_grid_to_particles)
    end subroutine remap_velocities
 
    !> dt = CFL h / (sqrt(dim) max_p (c_p + |v_p|)), limited by the viscous step CFL rho h^2 / (2 dim mu)

@@ -16,7 +16,9 @@ module simulation
    use mpm_solver, only: solver_t
    use run_diagnostics, only: diagnostics_t, diagnostics_header, diagnostics_row
    use csv_writer, only: csv_writer_t, keep_rows_until
-   use run_summary, only: write_run_summary
+   use run_summary, only: write_run_summary, write_timing
+   use phase_timers, only: phase_health, phase_diagnostics, phase_output, phase_checkpoint, phase_rebalance, &
+                           phase_other, phase_names
    use progress_reporter, only: progress_reporter_t
    use status_broadcast, only: broadcast_status, agree_on_status
    use health_check, only: particles_healthy, describe_unhealthy_particle
@@ -94,6 +96,8 @@ contains
       first_step = solver%step
       particle_steps = 0
       outcome = 'finished'
+      call solver%timers%reset()
+      call solver%timers%switch_to(phase_other)
 
       do while (solver%time < end_time * (1.0_rp - 1.0e-12_rp) .and. solver%step < solver%run%max_steps)
          ! land exactly on the next output time
@@ -103,6 +107,7 @@ contains
          call solver%advance()
          call reporter%update(solver%time, solver%step, diag%particles, solver%domain%rank == 0)
 
+         call solver%timers%switch_to(phase_health)
          flags = 0
          if (.not. particles_healthy(solver%particles, speed_limit)) flags(flag_unhealthy) = 1
          flags(flag_signal) = received_termination_signal()
@@ -111,6 +116,7 @@ contains
                flags(flag_wall_checkpoint) = 1
          end if
          call MPI_Allreduce(MPI_IN_PLACE, flags, size(flags), MPI_INTEGER, MPI_MAX, solver%domain%comm)
+         call solver%timers%switch_to(phase_other)
 
          if (flags(flag_unhealthy) > 0) then
             call report_blow_up(solver, progress, speed_limit, status)
@@ -122,13 +128,18 @@ contains
                      solver%step >= solver%run%max_steps
          ! between steps, and before an output so that its shares are balanced ones
          if (at_output .or. mod(solver%step, int(solver%run%rebalance_interval, i8)) == 0) then
+            call solver%timers%switch_to(phase_rebalance)
             call solver%balance_load(status)
+            call solver%timers%switch_to(phase_other)
             if (.not. status%ok) exit
          end if
          if (at_output) then
+            call solver%timers%switch_to(phase_diagnostics)
             diag = solver%diagnostics()
             if (solver%domain%rank == 0) call csv%write_row(diagnostics_row(diag))
+            call solver%timers%switch_to(phase_output)
             call write_output(solver, progress, status)
+            call solver%timers%switch_to(phase_other)
             if (.not. status%ok) exit
             progress%next_output_time = min(progress%next_output_time + interval, end_time)
          end if
@@ -137,7 +148,9 @@ contains
          if (solver%run%checkpoint_interval_steps > 0) &
             checkpoint_due = checkpoint_due .or. mod(solver%step, solver%run%checkpoint_interval_steps) == 0
          if (checkpoint_due) then
+            call solver%timers%switch_to(phase_checkpoint)
             call write_checkpoint(solver, progress, dir, solver%run%checkpoints_kept, checkpoint_path, status)
+            call solver%timers%switch_to(phase_other)
             if (.not. status%ok) exit
             last_checkpoint_wall = reporter%elapsed()
             last_checkpoint_step = solver%step
@@ -153,14 +166,17 @@ contains
       end do
 
       ! the final state, unless the loop just saved it (or failed)
+      call solver%timers%switch_to(phase_checkpoint)
       if (status%ok .and. last_checkpoint_step /= solver%step) &
          call write_checkpoint(solver, progress, dir, solver%run%checkpoints_kept, checkpoint_path, status)
       call csv%close()
+      call solver%timers%switch_to(phase_other)
       if (.not. status%ok .and. outcome == 'finished') outcome = 'failed'
       block
          type(status_t) :: summary_status     ! a summary that cannot be written must not hide the run's own status
          call write_run_summary(dir, solver%domain%comm, reporter%elapsed(), solver%step - first_step, &
                                 particle_steps, outcome, summary_status)
+         call write_timing(dir, solver%domain%comm, solver%timers%seconds, phase_names, summary_status)
          if (status%ok .and. .not. summary_status%ok) status = summary_status
       end block
    end subroutine run_simulation

@@ -11,14 +11,14 @@ module c0_anti_locking
    use kinds, only: rp
    use particle_set, only: particle_set_t
    use stabilizer, only: stabilizer_t, stage_context_t
-   use cell_binning, only: occupied_cells, bin_cell_mass, replace_by_cell_average
+   use cell_binning, only: cell_list_t, start_cell_list, bin_cell_mass, replace_by_cell_average
    implicit none
    private
 
    type, extends(stabilizer_t), public :: c0_anti_locking_t
       logical :: volumetric_only = .false.
-      integer :: occupied(2) = [1, 0]            !< lowest, highest owned cell holding the material at x^n
-      real(rp), allocatable :: cell_mass(:)      !< m_c of the owned cells (this material; occupied ones only)
+      type(cell_list_t) :: occupied              !< the owned cells holding the material at x^n
+      real(rp), allocatable :: cell_mass(:)      !< m_c of the owned cells (this material; 0 where unlisted)
       real(rp), allocatable :: average(:, :)     !< work: cell averages (kept between steps)
    contains
       procedure :: prepare => c0_prepare
@@ -35,7 +35,6 @@ contains
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
       call self%size_cell_arrays(context%grid%cell_count, particles%n_sigma)
-      self%occupied = occupied_cells(particles, context%first, context%last)
       call bin_cell_mass(particles, context%first, context%last, self%occupied, self%cell_mass)
    end subroutine c0_prepare
 
@@ -48,6 +47,7 @@ contains
          deallocate (self%cell_mass, self%average)
       end if
       allocate (self%cell_mass(cell_count), self%average(n_sigma, cell_count))
+      call start_cell_list(cell_count, self%occupied, self%cell_mass)
    end subroutine c0_size_cell_arrays
 
    !> Filter part A: d_p := d~_c ([Y17] eq. 4, left). Volumetric part: the dim in-plane normal components.

@@ -2,6 +2,12 @@
 !> ([Y17] eq. 4): m_c = sum m_p, x_o^c = sum m_p x_p / m_c, q_c = sum m_p q_p / m_c.
 !> Particles are binned by particles%cell, their cell at x^n.
 !>
+!> Only the cells that hold particles are touched: binning the masses lists them (cell_list_t), and
+!> every later routine works through the list. A range of cell numbers would also cover the empty
+!> cells between them: a water column filling 40 % of the tank's width made 2.5 times as many cells to
+!> clear, divide and pack. The list relies on cell_mass being 0 on every cell not listed (cleared when
+!> the arrays are made and through the previous list at every binning) and on positive particle masses.
+!>
 !> The per-particle loops are memory-bound passes over the slice. Their kernels take the number of
 !> values per particle as an argument and are called with a literal (2, 3, 4, 6) for the sizes that
 !> occur, so the compiler specialises them: a section of unknown length per particle became a library
@@ -12,59 +18,79 @@ module cell_binning
    implicit none
    private
 
-   public :: occupied_cells, bin_cell_mass, bin_cell_mass_and_centre, cell_average, replace_by_cell_average
+   !> The distinct cells holding one material's particles, in the order the particles first reach them.
+   type, public :: cell_list_t
+      integer :: count = 0
+      integer, allocatable :: cells(:)     !< cells(1:count); sized to the rank's cells
+   end type cell_list_t
+
+   public :: start_cell_list, bin_cell_mass, bin_cell_mass_and_centre, cell_average, replace_by_cell_average
    public :: divide_by_cell_mass, gather_cell_values
 
 contains
 
-   !> Lowest and highest cell of the particles first..last ([1, 0] if there are none). The routines below
-   !> write the cells of this range only (half the grid is air in a tank); cells outside it keep stale
-   !> values and must not be read.
-   pure function occupied_cells(particles, first, last) result(occupied)
-      type(particle_set_t), intent(in) :: particles
-      integer, intent(in) :: first, last
-      integer :: occupied(2)
-      occupied = [1, 0]
-      if (last < first) return
-      occupied = [minval(particles%cell(first:last)), maxval(particles%cell(first:last))]
-   end function occupied_cells
+   !> A new, empty list for `cell_count` cells; cell_mass (of that size) is cleared to match.
+   subroutine start_cell_list(cell_count, occupied, cell_mass)
+      integer, intent(in) :: cell_count
+      type(cell_list_t), intent(inout) :: occupied
+      real(rp), intent(inout) :: cell_mass(:)
+      if (allocated(occupied%cells)) deallocate (occupied%cells)
+      allocate (occupied%cells(cell_count))
+      occupied%count = 0
+      cell_mass = 0.0_rp
+   end subroutine start_cell_list
 
-   !> m_c of the cells holding particles first..last.
+   !> m_c of the cells holding particles first..last, which `occupied` lists afterwards.
    subroutine bin_cell_mass(particles, first, last, occupied, cell_mass)
       type(particle_set_t), intent(in) :: particles
-      integer, intent(in) :: first, last, occupied(2)
+      integer, intent(in) :: first, last
+      type(cell_list_t), intent(inout) :: occupied
       real(rp), intent(inout) :: cell_mass(:)
+      call clear_listed(occupied, cell_mass)
       if (last < first) return
-      cell_mass(occupied(1):occupied(2)) = 0.0_rp
-      call mass_sums(particles%cell(first:last), particles%mass(first:last), cell_mass)
+      call mass_sums(particles%cell(first:last), particles%mass(first:last), cell_mass, occupied%cells, occupied%count)
    end subroutine bin_cell_mass
 
-   !> m_c and the mass centre x_o^c (where m_c > 0) of the particles first..last, in one pass.
+   !> m_c and the mass centre x_o^c (where m_c > 0) of the particles first..last, in one pass; `occupied`
+   !> lists their cells afterwards. `centre` is written on the listed cells only.
    subroutine bin_cell_mass_and_centre(particles, first, last, occupied, cell_mass, centre)
       type(particle_set_t), intent(in) :: particles
-      integer, intent(in) :: first, last, occupied(2)
+      integer, intent(in) :: first, last
+      type(cell_list_t), intent(inout) :: occupied
       real(rp), intent(inout) :: cell_mass(:), centre(:, :)
+      call clear_listed(occupied, cell_mass)
       if (last < first) return
-      cell_mass(occupied(1):occupied(2)) = 0.0_rp
-      centre(:, occupied(1):occupied(2)) = 0.0_rp
       select case (size(centre, 1))
       case (2)
          call mass_and_moment_sums(2, particles%cell(first:last), particles%mass(first:last), particles%x(:, first:last), &
-                                   cell_mass, centre)
+                                   cell_mass, centre, occupied%cells, occupied%count)
          call divide_by_cell_mass(2, occupied, cell_mass, centre)
       case default
          call mass_and_moment_sums(3, particles%cell(first:last), particles%mass(first:last), particles%x(:, first:last), &
-                                   cell_mass, centre)
+                                   cell_mass, centre, occupied%cells, occupied%count)
          call divide_by_cell_mass(3, occupied, cell_mass, centre)
       end select
    end subroutine bin_cell_mass_and_centre
 
+   !> cell_mass := 0 on the listed cells, and the list emptied (so cell_mass is 0 everywhere).
+   subroutine clear_listed(occupied, cell_mass)
+      type(cell_list_t), intent(inout) :: occupied
+      real(rp), intent(inout) :: cell_mass(:)
+      integer :: i
+      do i = 1, occupied%count
+         cell_mass(occupied%cells(i)) = 0.0_rp
+      end do
+      occupied%count = 0
+   end subroutine clear_listed
+
    !> average(:, c) = sum m_p values(:, p) / m_c over the particles first..last; values(:, p - first + 1)
-   !> belongs to particle p. Empty cells of the occupied range get 0. `average` is read as (n, cells) with
+   !> belongs to particle p; `occupied` lists their cells (made by binning the same particles in the same
+   !> cells, in the same order). Only the listed cells are written. `average` is read as (n, cells) with
    !> n = size(values, 1) (it may be a larger work array).
    subroutine cell_average(particles, first, last, occupied, cell_mass, values, average)
       type(particle_set_t), intent(in) :: particles
-      integer, intent(in) :: first, last, occupied(2)
+      integer, intent(in) :: first, last
+      type(cell_list_t), intent(in) :: occupied
       real(rp), intent(in) :: cell_mass(:), values(:, :)
       real(rp), intent(inout) :: average(:, :)
       integer :: n
@@ -88,7 +114,8 @@ contains
    !> `average` is work space of at least size(values, 1) * size(cell_mass) values.
    subroutine replace_by_cell_average(particles, first, last, occupied, cell_mass, values, average)
       type(particle_set_t), intent(in) :: particles
-      integer, intent(in) :: first, last, occupied(2)
+      integer, intent(in) :: first, last
+      type(cell_list_t), intent(in) :: occupied
       real(rp), intent(in) :: cell_mass(:)
       real(rp), intent(inout) :: values(:, :)
       real(rp), intent(inout) :: average(:, :)
@@ -111,13 +138,15 @@ contains
       end select
    end subroutine gather_cell_values
 
-   !> sums(:, c) := sums(:, c) / m_c where m_c > 0, for the occupied cells.
+   !> sums(:, c) := sums(:, c) / m_c where m_c > 0, for the listed cells.
    subroutine divide_by_cell_mass(n, occupied, cell_mass, sums)
-      integer, intent(in) :: n, occupied(2)
+      integer, intent(in) :: n
+      type(cell_list_t), intent(in) :: occupied
       real(rp), intent(in) :: cell_mass(:)
       real(rp), intent(inout) :: sums(n, *)
-      integer :: c
-      do c = occupied(1), occupied(2)
+      integer :: i, c
+      do i = 1, occupied%count
+         c = occupied%cells(i)
          if (cell_mass(c) > 0.0_rp) sums(:, c) = sums(:, c) / cell_mass(c)
       end do
    end subroutine divide_by_cell_mass
@@ -126,21 +155,30 @@ contains
    ! sorted by cell (nearly, between two full sorts), so a sum is kept in registers along a run of equal
    ! cells and stored once per run; a cell met again later continues from its stored sum. These are the
    ! same additions in the same order as summing in memory particle by particle, without a store-to-load
-   ! round trip per particle on the dependency chain (measured: half the time of the plain loop). ---
+   ! round trip per particle on the dependency chain (measured: half the time of the plain loop).
+   ! The mass sums list a cell when a run starts on it with a mass of 0: its first visit (cell_mass is 0
+   ! on unlisted cells, particle masses are positive). ---
 
-   subroutine mass_sums(cell, mass, cell_mass)
+   subroutine mass_sums(cell, mass, cell_mass, list, count)
       integer, intent(in) :: cell(:)
       real(rp), intent(in) :: mass(:)
       real(rp), intent(inout) :: cell_mass(:)
+      integer, intent(inout) :: list(:), count
       integer :: i, c
       real(rp) :: running_mass
       c = cell(1)
-      running_mass = cell_mass(c)
+      running_mass = 0.0_rp
+      count = 1
+      list(1) = c
       do i = 1, size(cell)
          if (cell(i) /= c) then
             cell_mass(c) = running_mass
             c = cell(i)
             running_mass = cell_mass(c)
+            if (running_mass <= 0.0_rp) then
+               count = count + 1
+               list(count) = c
+            end if
          end if
          running_mass = running_mass + mass(i)
       end do
@@ -148,41 +186,64 @@ contains
    end subroutine mass_sums
 
    subroutine mass_weighted_sums(n, occupied, cell, mass, values, sums)
-      integer, intent(in) :: n, occupied(2), cell(:)
+      integer, intent(in) :: n, cell(:)
+      type(cell_list_t), intent(in) :: occupied
       real(rp), intent(in) :: mass(:), values(n, *)
       real(rp), intent(inout) :: sums(n, *)
-      integer :: i, c
+      integer :: i, c, next
       real(rp) :: running(n)
-      sums(:, occupied(1):occupied(2)) = 0.0_rp
+      ! The runs of equal cells come in the order in which the list was made (same particles, same
+      ! cells), so a run on the next cell of the list is that cell's first visit: its sum starts at 0
+      ! without a clearing pass over the cells.
+      if (occupied%count == 0) return
       c = cell(1)
-      running = sums(:, c)
+      running = 0.0_rp
+      next = 2
       do i = 1, size(cell)
          if (cell(i) /= c) then
             sums(:, c) = running
             c = cell(i)
-            running = sums(:, c)
+            if (next <= occupied%count) then
+               if (c == occupied%cells(next)) then
+                  next = next + 1
+                  running = 0.0_rp
+               else
+                  running = sums(:, c)
+               end if
+            else
+               running = sums(:, c)
+            end if
          end if
          running = running + mass(i) * values(:, i)
       end do
       sums(:, c) = running
    end subroutine mass_weighted_sums
 
-   subroutine mass_and_moment_sums(n, cell, mass, x, cell_mass, moment)
+   subroutine mass_and_moment_sums(n, cell, mass, x, cell_mass, moment, list, count)
       integer, intent(in) :: n, cell(:)
       real(rp), intent(in) :: mass(:), x(n, *)
       real(rp), intent(inout) :: cell_mass(:), moment(n, *)
+      integer, intent(inout) :: list(:), count
       integer :: i, c
       real(rp) :: running_mass, running_moment(n)
       c = cell(1)
-      running_mass = cell_mass(c)
-      running_moment = moment(:, c)
+      running_mass = 0.0_rp
+      running_moment = 0.0_rp
+      count = 1
+      list(1) = c
       do i = 1, size(cell)
          if (cell(i) /= c) then
             cell_mass(c) = running_mass
             moment(:, c) = running_moment
             c = cell(i)
             running_mass = cell_mass(c)
-            running_moment = moment(:, c)
+            if (running_mass <= 0.0_rp) then      ! first visit: the moment is not cleared in memory
+               count = count + 1
+               list(count) = c
+               running_moment = 0.0_rp
+            else
+               running_moment = moment(:, c)
+            end if
          end if
          running_mass = running_mass + mass(i)
          running_moment = running_moment + mass(i) * x(:, i)

@@ -13,7 +13,7 @@ module foal1_smoothing
    use particle_set, only: particle_set_t
    use stabilizer, only: stage_context_t
    use c0_anti_locking, only: c0_anti_locking_t
-   use cell_binning, only: occupied_cells, bin_cell_mass_and_centre, cell_average, gather_cell_values
+   use cell_binning, only: cell_list_t, bin_cell_mass_and_centre, cell_average, gather_cell_values
    use cell_halo, only: padded_cells_t, exchange_cell_halo, halo_width
    use background_grid, only: grid_t
    use limited_flux_smoothing, only: flux_options_t, flux_workspace_t, limited_flux_increments
@@ -29,7 +29,8 @@ module foal1_smoothing
       ! work arrays kept between steps
       real(rp), allocatable :: q_cell(:, :), field(:, :), dq(:, :)
       logical, allocatable :: exists(:)
-      integer :: packed(2) = [1, 0]            !< owned cells written into `field` by the last step
+      integer, allocatable :: packed(:)        !< packed(1:n_packed): owned cells written into `field` by the last step
+      integer :: n_packed = 0
       type(flux_workspace_t) :: workspace
    contains
       procedure :: prepare => foal1_prepare
@@ -46,13 +47,12 @@ contains
       call self%size_cell_arrays(context%grid%cell_count, particles%n_sigma)
       if (.not. same_cells(self%box, context%grid)) then
          call self%box%init(context%grid)
-         if (allocated(self%q_cell)) deallocate (self%q_cell, self%field, self%dq, self%exists)   ! a new layout
+         if (allocated(self%q_cell)) deallocate (self%q_cell, self%field, self%dq, self%exists, self%packed)   ! a new layout
       end if
       if (allocated(self%centre)) then
          if (size(self%centre, 2) /= context%grid%cell_count) deallocate (self%centre)
       end if
       if (.not. allocated(self%centre)) allocate (self%centre(context%grid%dim, context%grid%cell_count))
-      self%occupied = occupied_cells(particles, context%first, context%last)
       call bin_cell_mass_and_centre(particles, context%first, context%last, self%occupied, self%cell_mass, self%centre)
    end subroutine foal1_prepare
 
@@ -62,14 +62,12 @@ contains
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
       real(rp), allocatable :: q(:, :)
-      integer :: first, last, nq, dim, p, c, lo, hi, i
+      integer :: first, last, nq, dim, p, c, i
 
       first = context%first
       last = context%last
       dim = context%grid%dim
       nq = merge(1, particles%n_sigma, self%pressure_only)
-      lo = self%occupied(1)
-      hi = self%occupied(2)
 
       call ensure_work_arrays(self, nq, dim, context%grid%cell_count)
 
@@ -87,14 +85,12 @@ contains
          end if
 
          ! padded cell field: exists, m_c, x_o^c, q_c; ghost layers from the neighbours (collective). Rows
-         ! other than "exists" are read only where it is set. Only the occupied range is written: first
-         ! clear the cells the last step wrote outside it (the rest of `field` and `exists` stays 0 from
-         ! allocation, or is rewritten by every exchange).
-         do c = self%packed(1), min(self%packed(2), lo - 1)
-            field(1, of_owned(c)) = 0.0_rp
-            exists(of_owned(c)) = .false.
-         end do
-         do c = max(self%packed(1), hi + 1), self%packed(2)
+         ! other than "exists" are read only where it is set. Only the occupied cells are written: first
+         ! clear the cells the last step wrote that hold none of the material now (m_c = 0: unlisted);
+         ! the rest of `field` and `exists` stays 0 from allocation, or is rewritten by every exchange.
+         do i = 1, self%n_packed
+            c = self%packed(i)
+            if (self%cell_mass(c) > 0.0_rp) cycle
             field(1, of_owned(c)) = 0.0_rp
             exists(of_owned(c)) = .false.
          end do
@@ -105,7 +101,8 @@ contains
          else
             call pack_cells(dim, nq, self%occupied, of_owned, self%cell_mass, self%centre, q_cell, field, exists)
          end if
-         self%packed = self%occupied
+         self%n_packed = self%occupied%count
+         self%packed(1:self%n_packed) = self%occupied%cells(1:self%n_packed)
          call exchange_cell_halo(context%domain, context%grid, self%box, field)
          associate (ghost => self%box%ghost)
             do i = 1, size(ghost)
@@ -144,16 +141,18 @@ contains
       end associate
    end subroutine foal1_filter_stress
 
-   !> field(:, of_owned(c)) := [1, m_c, x_o^c, q_c] for the cells c of the occupied range holding the
-   !> material, field(1, of_owned(c)) := 0 for the others; exists likewise. dim and nq are literals at the
+   !> field(:, of_owned(c)) := [1, m_c, x_o^c, q_c] for the listed cells c holding the material,
+   !> field(1, of_owned(c)) := 0 for the others; exists likewise. dim and nq are literals at the
    !> calls that matter (a section copy of unknown length per cell is a library call).
    subroutine pack_cells(dim, nq, occupied, of_owned, cell_mass, centre, q_cell, field, exists)
-      integer, intent(in) :: dim, nq, occupied(2), of_owned(:)
+      integer, intent(in) :: dim, nq, of_owned(:)
+      type(cell_list_t), intent(in) :: occupied
       real(rp), intent(in) :: cell_mass(:), centre(dim, *), q_cell(nq, *)
       real(rp), intent(inout) :: field(2 + dim + nq, *)
       logical, intent(inout) :: exists(:)
-      integer :: c, i
-      do c = occupied(1), occupied(2)
+      integer :: c, i, k
+      do k = 1, occupied%count
+         c = occupied%cells(k)
          i = of_owned(c)
          exists(i) = cell_mass(c) > 0.0_rp
          if (exists(i)) then
@@ -167,13 +166,15 @@ contains
       end do
    end subroutine pack_cells
 
-   !> q_cell(:, c) := q_c + dq_c (eq. 13) for the occupied cells holding the material.
+   !> q_cell(:, c) := q_c + dq_c (eq. 13) for the listed cells holding the material.
    subroutine add_increments(nq, occupied, of_owned, cell_mass, dq, q_cell)
-      integer, intent(in) :: nq, occupied(2), of_owned(:)
+      integer, intent(in) :: nq, of_owned(:)
+      type(cell_list_t), intent(in) :: occupied
       real(rp), intent(in) :: cell_mass(:), dq(nq, *)
       real(rp), intent(inout) :: q_cell(nq, *)
-      integer :: c
-      do c = occupied(1), occupied(2)
+      integer :: c, k
+      do k = 1, occupied%count
+         c = occupied%cells(k)
          if (cell_mass(c) > 0.0_rp) q_cell(:, c) = q_cell(:, c) + dq(:, of_owned(c))
       end do
    end subroutine add_increments
@@ -185,13 +186,13 @@ contains
       integer, intent(in) :: nq, dim, cell_count
       if (allocated(self%q_cell)) then
          if (size(self%q_cell, 2) == cell_count .and. size(self%field, 2) == self%box%count) return
-         deallocate (self%q_cell, self%field, self%dq, self%exists)
+         deallocate (self%q_cell, self%field, self%dq, self%exists, self%packed)
       end if
       allocate (self%q_cell(nq, cell_count), self%field(2 + dim + nq, self%box%count), self%dq(nq, self%box%count), &
-                self%exists(self%box%count))
+                self%exists(self%box%count), self%packed(cell_count))
       self%field = 0.0_rp
       self%exists = .false.
-      self%packed = [1, 0]
+      self%n_packed = 0
       self%workspace = flux_workspace_t()     ! it belongs to the old dq
    end subroutine ensure_work_arrays
 

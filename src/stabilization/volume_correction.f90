@@ -11,7 +11,8 @@
 !>                   (inside the walls and the grid), is 1 where particles fill space as their volumes say
 !>                   and > 1 where they crowd. Particles move down the gradient of the excess
 !>                     psi_i = max(phi_i - 1, 0),   dx_p = -D h^2 sum_i grad N_i(x_p) psi_i
-!>                   (D = shifting_coefficient, at most 0.1 h per step). One-sided: a node that is not
+!>                   (D = shifting_coefficient per step; applied every k steps with k D, k = 0.2 / D,
+!>                   so that its cost is a k-th, at most 0.1 h per application). One-sided: a node that is not
 !>                   full (free surface, walls, spray) never pulls particles, so surfaces do not spread.
 !>                   Positions only: mass, momentum of each particle, J and stress are kept.
 !>   eos_relaxation  pull the pressure back toward the equation of state p_EOS = K ln(rho/rho_0) after the
@@ -23,11 +24,11 @@
 !> particle-to-grid transfer; the shifts are added after the position update, so the wall safeguard and
 !> the migration of the step see them. Costs nothing without a fluid that selects it.
 module volume_correction
-   use kinds, only: rp
+   use kinds, only: rp, i8
    use scene_description, only: scene_t
    use domain_decomposition, only: domain_t
    use background_grid, only: grid_t
-   use shape_functions, only: n_corners, corner_offset, shape_values_and_gradients
+   use grid_transfer, only: volume_to_grid, gradient_at_particles
    use node_halo, only: sum_shared_nodes
    use particle_set, only: particle_set_t
    use boundary_walls, only: wall_t, wall_kind_prescribed, behind_wall
@@ -43,7 +44,10 @@ module volume_correction
    real(rp), parameter :: min_open_fraction = 0.2_rp
    !> A sample closer to a wall than this fraction of h lies on it.
    real(rp), parameter :: on_wall_tolerance = 1.0e-9_rp
-   !> Largest shift per step, in cells (public: the active region widens the particles' extent by it).
+   !> The shifting runs every k steps with k D per application, k the largest with k D <= this: the
+   !> crowding builds over thousands of steps, so a k-th of the cost buys the same correction.
+   real(rp), parameter :: coefficient_per_application = 0.2_rp
+   !> Largest shift per application, in cells (public: the active region widens the particles' extent by it).
    real(rp), parameter, public :: max_shift_in_cells = 0.1_rp
 
    type, public :: volume_corrector_t
@@ -51,6 +55,8 @@ module volume_correction
       real(rp), allocatable :: relaxation_rate(:)       !< per material: r, 0 without EOS relaxation
       real(rp), allocatable :: bulk_modulus(:), reference_density(:)
       logical :: shifting = .false.                 !< some material shifts
+      integer :: interval = 1                       !< steps between two applications of the shifting
+      logical :: shifting_now = .false.             !< this step applies it
       real(rp) :: gravity(3) = 0.0_rp               !< grid frame: the hydrostatic pressure change of a shift
       real(rp), allocatable :: open_volume(:)       !< V_i per local node [m^dim]
       logical, allocatable :: wall_activity(:)      !< walls' activity V_i was measured with
@@ -88,6 +94,8 @@ contains
          end associate
       end do
       self%shifting = any(self%shifting_coefficient > 0.0_rp)
+      if (self%shifting) self%interval = max(1, floor(coefficient_per_application / maxval(self%shifting_coefficient) &
+                                                       * (1.0_rp + 1.0e-12_rp)))
    end subroutine corrector_init
 
    pure logical function corrector_active(self)
@@ -102,17 +110,20 @@ contains
       if (allocated(self%wall_activity)) deallocate (self%wall_activity)
    end subroutine corrector_reset_grid
 
-   !> At x^n, before the step's particle-to-grid transfer: the shifts of this step. Collective.
-   subroutine corrector_prepare(self, domain, grid, walls, particles)
+   !> At x^n, before the step's particle-to-grid transfer: the shifts of step `step` (every interval-th
+   !> step; by the step number, so a restart keeps the rhythm). Collective.
+   subroutine corrector_prepare(self, domain, grid, walls, particles, step)
       class(volume_corrector_t), intent(inout) :: self
       type(domain_t), intent(in) :: domain
       type(grid_t), intent(in) :: grid
       type(wall_t), intent(in) :: walls(:)
       type(particle_set_t), intent(in) :: particles
+      integer(i8), intent(in) :: step
       integer :: i
       real(rp) :: threshold
 
-      if (.not. self%shifting) return
+      self%shifting_now = self%shifting .and. mod(step, int(self%interval, i8)) == 0
+      if (.not. self%shifting_now) return
       if (.not. allocated(self%wall_activity)) then
          call measure_open_volumes(self, grid, walls)
       else if (any(self%wall_activity .neqv. walls%active)) then
@@ -123,7 +134,8 @@ contains
       end if
       if (.not. allocated(self%excess)) allocate (self%excess(1, grid%node_count))
 
-      call accumulate_occupancy(grid, particles, self%excess(1, :))
+      self%excess = 0.0_rp
+      call volume_to_grid(grid, particles, self%excess(1, :))
       call sum_shared_nodes(domain, grid, self%excess)
       threshold = min_open_fraction * grid%h**grid%dim
       do i = 1, grid%node_count
@@ -136,26 +148,6 @@ contains
       call shifts_of_particles(self, grid, particles, self%open_volume >= threshold)
    end subroutine corrector_prepare
 
-   !> o_i = sum_p N_ip V_p over the particles of all materials.
-   subroutine accumulate_occupancy(grid, particles, occupancy)
-      type(grid_t), intent(in) :: grid
-      type(particle_set_t), intent(in) :: particles
-      real(rp), intent(out) :: occupancy(:)
-      real(rp) :: n(n_corners(grid%dim)), g(grid%dim, n_corners(grid%dim)), xi(3)
-      integer :: p, a, base, dim, nc
-      dim = grid%dim
-      nc = n_corners(dim)
-      occupancy = 0.0_rp
-      do p = 1, particles%count
-         call locate(grid, particles%x(:, p), base, xi)
-         call shape_values_and_gradients(dim, xi(1:dim), grid%inv_h, n, g)
-         do a = 1, nc
-            occupancy(base + grid%corner_stride(a)) = occupancy(base + grid%corner_stride(a)) + &
-                                                      n(a) * particles%mass(p) / particles%density(p)
-         end do
-      end do
-   end subroutine accumulate_occupancy
-
    !> dx_p = -D h^2 sum_a grad N_a psi_a for the particles of shifting materials, at most 0.1 h long.
    !> A node mostly closed by walls has no reliable occupancy: it takes the particle's own excess (the
    !> N-weighted mean over the reliable corners), so a wall is neither a sink nor a source (zero normal
@@ -165,48 +157,21 @@ contains
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(in) :: particles
       logical, intent(in) :: reliable(:)
-      real(rp) :: n(n_corners(grid%dim)), g(grid%dim, n_corners(grid%dim)), psi(n_corners(grid%dim))
-      real(rp) :: xi(3), gradient(3), length, scale, longest, weight, mean
-      integer :: m, p, a, base, dim, nc, node
-      logical :: all_reliable
-      dim = grid%dim
-      nc = n_corners(dim)
+      real(rp) :: length, scale, longest
+      integer :: m, p
       if (allocated(self%shift)) then
          if (size(self%shift, 2) < particles%count) deallocate (self%shift)
       end if
-      if (.not. allocated(self%shift)) allocate (self%shift(dim, max(1, size(particles%x, 2))))
-      self%shift(:, 1:particles%count) = 0.0_rp
+      if (.not. allocated(self%shift)) allocate (self%shift(grid%dim, max(1, size(particles%x, 2))))
       longest = max_shift_in_cells * grid%h
       do m = 1, size(self%shifting_coefficient)
          if (self%shifting_coefficient(m) <= 0.0_rp) cycle
-         scale = self%shifting_coefficient(m) * grid%h**2
+         if (particles%material_last(m) < particles%material_first(m)) cycle
+         call gradient_at_particles(grid, particles, particles%material_first(m), particles%material_last(m), &
+                                    self%excess(1, :), reliable, self%shift)
+         scale = -self%shifting_coefficient(m) * self%interval * grid%h**2
          do p = particles%material_first(m), particles%material_last(m)
-            call locate(grid, particles%x(:, p), base, xi)
-            call shape_values_and_gradients(dim, xi(1:dim), grid%inv_h, n, g)
-            all_reliable = .true.
-            weight = 0.0_rp
-            mean = 0.0_rp
-            do a = 1, nc
-               node = base + grid%corner_stride(a)
-               psi(a) = self%excess(1, node)
-               if (reliable(node)) then
-                  weight = weight + n(a)
-                  mean = mean + n(a) * psi(a)
-               else
-                  all_reliable = .false.
-               end if
-            end do
-            if (.not. all_reliable) then
-               if (weight > 0.0_rp) mean = mean / weight
-               do a = 1, nc
-                  if (.not. reliable(base + grid%corner_stride(a))) psi(a) = mean
-               end do
-            end if
-            gradient(1:dim) = 0.0_rp
-            do a = 1, nc
-               gradient(1:dim) = gradient(1:dim) + g(1:dim, a) * psi(a)
-            end do
-            self%shift(:, p) = -scale * gradient(1:dim)
+            self%shift(:, p) = scale * self%shift(:, p)
             length = norm2(self%shift(:, p))
             if (length > longest) self%shift(:, p) = self%shift(:, p) * (longest / length)
          end do
@@ -220,7 +185,7 @@ contains
       class(volume_corrector_t), intent(in) :: self
       type(particle_set_t), intent(inout) :: particles
       integer :: m, p, dim
-      if (.not. self%shifting) return
+      if (.not. self%shifting_now) return
       dim = particles%dim
       do m = 1, size(self%shifting_coefficient)
          if (self%shifting_coefficient(m) <= 0.0_rp) cycle
@@ -355,23 +320,4 @@ contains
       end function next_sample
    end subroutine measure_open_volumes
 
-   !> Local index of the lower node of the particle's cell and the fractional position in the cell
-   !> (the rule of grid_transfer's kernels: the upper face of the whole grid belongs to the last cell).
-   pure subroutine locate(grid, x, base, xi)
-      type(grid_t), intent(in) :: grid
-      real(rp), intent(in) :: x(:)
-      integer, intent(out) :: base
-      real(rp), intent(out) :: xi(3)
-      integer :: k, c, stride
-      base = 1
-      stride = 1
-      xi = 0.0_rp
-      do k = 1, grid%dim
-         xi(k) = (x(k) - grid%origin(k)) * grid%inv_h
-         c = min(floor(xi(k)), grid%global_cells(k) - 1)
-         xi(k) = xi(k) - real(c, rp)
-         base = base + (c - grid%node_lo(k)) * stride
-         stride = stride * grid%n_nodes(k)
-      end do
-   end subroutine locate
 end module volume_correction

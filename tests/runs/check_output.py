@@ -6,10 +6,13 @@ particle fields, unique ids, positions in the world frame, consistent stress fie
 mass sums to the total mass, the largest rank's share (max_rank_share) from the particles' ranks, and
 the XDMF files listing every output time. The 2-D scene runs on 3 ranks of which one holds no particle
 (load balancing off); the 3-D scene on 2 ranks, balanced: no rank holds more than 60 % of the
-particles at any output. Also runs scripts/plot_diagnostics.py.
+particles at any output. The run's timing.csv: every phase of the time loop, adding up to the loop's
+wall time, with nothing charged to the smoothing phase of a scene without smoothing. Also runs
+scripts/plot_diagnostics.py.
 
 usage: check_output.py <flotsam> <mpiexec> <tests/runs/scenes> <scripts folder>"""
 
+import csv
 import os
 import subprocess
 import sys
@@ -33,6 +36,7 @@ def check_run(checks, flotsam, scenes, name, ranks, fluid_materials, empty_rank=
     with open(scene) as f:
         text = f.read()
     dim = 3 if "dim = 3" in text else 2
+    check_timing(checks, name, directory, smoothed="stabilization" in text and "FOAL1" in text)
 
     for index, row in enumerate(rows):
         label = f"{name} output {index}"
@@ -116,6 +120,35 @@ def check_run(checks, flotsam, scenes, name, ranks, fluid_materials, empty_rank=
             with h5py.File(os.path.join(directory, file)) as f:
                 shapes_agree &= f[dataset].shape == tuple(int(d) for d in item.get("Dimensions").split())
     checks.check(shapes_agree, f"{name} grid.xmf: every data item has the shape of its dataset")
+
+
+PHASES = ["particles_to_grid", "grid_update", "walls", "stabilization", "grid_to_particles", "constitutive",
+          "inflow", "node_halo", "migration", "sort", "time_step", "health_check", "diagnostics", "output",
+          "checkpoint", "rebalance", "volume_correction", "other"]
+
+
+def check_timing(checks, name, directory, smoothed):
+    """timing.csv against run_summary.csv (docs/output.md)."""
+    with open(os.path.join(directory, "timing.csv"), newline="") as f:
+        rows = {row["phase"]: row for row in csv.DictReader(f)}
+    with open(os.path.join(directory, "run_summary.csv"), newline="") as f:
+        summary = next(csv.DictReader(f))
+    if not checks.check(list(rows) == PHASES + ["total"], f"{name} timing.csv: one row per phase and the total",
+                        f"{list(rows)}"):
+        return
+    mean = {phase: float(row["seconds_mean"]) for phase, row in rows.items()}
+    largest = {phase: float(row["seconds_max"]) for phase, row in rows.items()}
+    checks.check(all(0 <= mean[p] <= largest[p] for p in PHASES), f"{name} timing.csv: 0 <= mean <= max")
+    checks.close(sum(mean[p] for p in PHASES), mean["total"], 1e-9, f"{name} timing.csv: phases add up to the total")
+    wall = float(summary["wall_seconds"])
+    checks.check(0.5 * wall <= largest["total"] <= wall + 0.05, f"{name} timing.csv: total within the run's wall time",
+                 f"{largest['total']} s of {wall} s")
+    checks.check(mean["particles_to_grid"] > 0 and mean["grid_to_particles"] > 0, f"{name} timing.csv: the transfers")
+    if not smoothed:
+        # two clock reads per step; the margin is for the rank being descheduled between them on a busy machine
+        checks.check(largest["stabilization"] < 0.01 * largest["total"] + 0.005,
+                     f"{name} timing.csv: no smoothing, no time for it",
+                     f"{largest['stabilization']} s of {largest['total']} s")
 
 
 def main():

@@ -1,14 +1,14 @@
 !> Point updates of the constitutive models against closed-form results.
 module test_constitutive_updates
-   use kinds, only: rp
-   use assertions, only: assertEqual, assertRelativelyEqual
+   use kinds, only: rp, i8
+   use assertions, only: assertEqual, assertRelativelyEqual, assertTrue
    use tensor_layout, only: mean_stress
-   use newtonian_fluid, only: fluid_point_update
+   use newtonian_fluid, only: fluid_point_update, newtonian_fluid_t
    use linear_elastic, only: elastic_point_update
    implicit none
    private
 
-   public :: test_fluid_pressure_increment, test_fluid_viscous_stress, test_elastic_uniaxial_strain, &
+   public :: test_fluid_pressure_increment, test_fluid_viscous_stress, test_inviscid_update_bitwise, test_elastic_uniaxial_strain, &
              test_elastic_uniaxial_stress_nu0, test_jaumann_hydrostatic_invariance, test_jaumann_rotation_rate
 
 contains
@@ -47,6 +47,51 @@ contains
       call assertRelativelyEqual(2 * mu * d(4), sigma(4), 1.0e-14_rp, 'shear stress 2 mu d_xy')
       call assertRelativelyEqual(2 * mu * (d(1) - d(2)), sigma(1) - sigma(2), 1.0e-12_rp, 'normal stress difference')
    end subroutine test_fluid_viscous_stress
+
+   !> With viscosity 0 the slice update takes a path without the viscous terms: it must give the bits of
+   !> the general point update with mu = 0, signs of zero included (zero pressure, shear rates of both
+   !> signs and -0), in 2-D and 3-D.
+   subroutine test_inviscid_update_bitwise()
+      real(rp) :: d(4, 3), sbar(4, 3), d3(6, 2), sbar3(6, 2)
+      d(:, 1) = [-0.3_rp, 0.1_rp, 0.0_rp, -0.05_rp]
+      d(:, 2) = [0.0_rp, 0.0_rp, 0.0_rp, -0.0_rp]          ! at rest with zero stress: p = 0
+      d(:, 3) = [0.2_rp, -0.2_rp, 0.0_rp, 0.7_rp]           ! tr d = 0
+      sbar = 0.0_rp
+      sbar(1:3, 1) = -30.0_rp
+      call check_inviscid_slice(2, d, sbar, '2-D')
+      d3(:, 1) = [0.2_rp, -0.1_rp, 0.4_rp, -0.01_rp, 0.0_rp, 0.03_rp]
+      d3(:, 2) = [0.1_rp, -0.1_rp, 0.0_rp, -0.0_rp, 0.0_rp, -0.03_rp]
+      sbar3 = 0.0_rp
+      call check_inviscid_slice(3, d3, sbar3, '3-D')
+   end subroutine test_inviscid_update_bitwise
+
+   !> The slice update of an inviscid fluid against fluid_point_update with mu = 0, bit for bit.
+   subroutine check_inviscid_slice(dim, d, sbar, label)
+      integer, intent(in) :: dim
+      real(rp), intent(in) :: d(:, :), sbar(:, :)
+      character(len=*), intent(in) :: label
+      real(rp), parameter :: dt = 1.0e-4_rp, k = 2.0e7_rp
+      type(newtonian_fluid_t) :: fluid
+      real(rp) :: spin(3, size(d, 2)), slice_sbar(size(sbar, 1), size(sbar, 2)), point_sbar(size(sbar, 1), size(sbar, 2))
+      real(rp) :: slice_density(size(d, 2)), point_density(size(d, 2))
+      integer :: p, n
+      fluid%bulk_modulus = k
+      fluid%viscosity = 0.0_rp
+      spin = 0.0_rp
+      n = size(d, 2)
+      slice_density = 1000.0_rp - [(2.0_rp * p, p = 1, n)]
+      point_density = slice_density
+      slice_sbar = sbar
+      point_sbar = sbar
+      do p = 1, n
+         call fluid_point_update(k, 0.0_rp, dim, dt, d(:, p), point_density(p), point_sbar(:, p))
+      end do
+      call fluid%update_stress(dim, dt, d, spin, slice_density, slice_sbar)
+      call assertTrue(all(transfer(slice_sbar, 0_i8, size(sbar)) == transfer(point_sbar, 0_i8, size(sbar))), &
+                      label//' sbar bit for bit')
+      call assertTrue(all(transfer(slice_density, 0_i8, n) == transfer(point_density, 0_i8, n)), &
+                      label//' density bit for bit')
+   end subroutine check_inviscid_slice
 
    !> Uniaxial strain in 3-D: sigma_xx = (lambda + 2 G) eps, sigma_yy = sigma_zz = lambda eps.
    subroutine test_elastic_uniaxial_strain()
