@@ -145,7 +145,7 @@ function(flotsam_add_test_suite)
                WORKING_DIRECTORY "${workdir}")
       set_tests_properties(${test_name} PROPERTIES
         PROCESSORS ${np}
-        ENVIRONMENT "OMPI_MCA_rmaps_base_oversubscribe=1;OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1"
+        ENVIRONMENT "OMPI_MCA_rmaps_base_oversubscribe=1;OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_io=romio321"
         LABELS "${ARG_LABELS};mpi"
         TIMEOUT ${ARG_TIMEOUT})
     endforeach()
@@ -217,7 +217,7 @@ macro(_flotsam_add_pfunit_wrapper)
     add_pfunit_ctest(${suite}_pfunit TEST_SOURCES "${_pf_file}" LINK_LIBRARIES ${suite}_objects
                      MAX_PES ${_pf_max_pes} WORKING_DIRECTORY "${_pf_workdir}")
     set_tests_properties(${suite}_pfunit PROPERTIES PROCESSORS ${_pf_max_pes}
-      ENVIRONMENT "OMPI_MCA_rmaps_base_oversubscribe=1;OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1")
+      ENVIRONMENT "OMPI_MCA_rmaps_base_oversubscribe=1;OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_io=romio321")
   else()
     add_pfunit_ctest(${suite}_pfunit TEST_SOURCES "${_pf_file}" LINK_LIBRARIES ${suite}_objects
                      WORKING_DIRECTORY "${_pf_workdir}")

@@ -1,10 +1,14 @@
 !> Benchmark driver: `mpirun -np N flotsam_bench scene.nml steps [output]`. Runs a scene for a fixed
 !> number of steps without output and prints one line of figures (scripts/bench collects them):
-!>   dim ranks particles steps seconds particle_steps_per_s_per_core bytes_per_particle
+!>   dim ranks particles steps seconds particle_steps_per_s_per_core bytes_per_particle peak_bytes
+!>   grid_nodes layouts cpu_seconds
 !> preceded by a line of the timed steps' wall time per phase (phase_timers; the slowest rank's):
 !>   phases <name>=<seconds> ...
 !> Memory per particle is the growth of the resident set from before the solver is built to after the
-!> timed steps, divided by the rank's particles (rank 0's view).
+!> timed steps, divided by the rank's particles (rank 0's view); peak_bytes the largest resident set
+!> of a rank (VmHWM); grid_nodes the nodes of all ranks' grids at the end; layouts how often the
+!> active region was laid out anew to follow the particles; cpu_seconds the processor time of the timed
+!> steps (the largest rank's), which on a shared machine varies less than the wall time.
 !> With `output`, it then times the output of the final state into the scene's output_dir (replaced):
 !> one fields file (particles and grid, the mean of 3 writes), one checkpoint, and the per-step health
 !> check of the time loop (the mean of 100 calls), and prints a second line:
@@ -13,7 +17,7 @@ program flotsam_bench
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use kinds, only: rp, i8
    use mpi_f08, only: MPI_Init, MPI_Finalize, MPI_Comm_rank, MPI_Comm_size, MPI_Barrier, MPI_Wtime, MPI_COMM_WORLD, &
-                      MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER, MPI_MAX, MPI_DOUBLE_PRECISION
+                      MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER, MPI_MAX, MPI_INTEGER8, MPI_SUM, MPI_DOUBLE_PRECISION
    use error_status, only: status_t
    use scene_description, only: scene_t
    use scene_reader, only: read_scene
@@ -26,7 +30,7 @@ program flotsam_bench
    use checkpoint, only: write_checkpoint
    use health_check, only: particles_healthy
    use simulation, only: blow_up_speed
-   use process_memory, only: resident_bytes
+   use process_memory, only: resident_bytes, peak_resident_bytes
    use phase_timers, only: phase_names, phase_rebalance, phase_other
    implicit none
 
@@ -36,7 +40,8 @@ program flotsam_bench
    type(diagnostics_t) :: diag
    character(len=4096) :: arg
    integer :: rank, n_ranks, steps, step, warm_up
-   real(rp) :: t0, t1, rss_before, rss_after
+   real(rp) :: t0, t1, rss_before, rss_after, cpu0, cpu1, cpu
+   integer(i8) :: peak, nodes
 
    call MPI_Init()
    call MPI_Comm_rank(MPI_COMM_WORLD, rank)
@@ -73,18 +78,26 @@ program flotsam_bench
    call solver%timers%reset()
    t0 = MPI_Wtime()
    call solver%timers%switch_to(phase_other)
+   call cpu_time(cpu0)
    do step = 1, steps
       call advance()
    end do
+   call cpu_time(cpu1)
    call MPI_Barrier(MPI_COMM_WORLD)
    t1 = MPI_Wtime()
    call solver%timers%switch_to(phase_other)
+   cpu = cpu1 - cpu0
+   call MPI_Allreduce(MPI_IN_PLACE, cpu, 1, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
    rss_after = real(resident_bytes(), rp)
    diag = solver%diagnostics()
    call print_phases()
-   if (rank == 0) write (output_unit, '(i0,1x,i0,1x,i0,1x,i0,1x,es12.5,1x,es12.5,1x,f10.1)') scene%grid%dim, n_ranks, &
-      diag%particles, steps, t1 - t0, real(diag%particles, rp) * steps / ((t1 - t0) * n_ranks), &
-      (rss_after - rss_before) / max(1, solver%particles%count)
+   peak = peak_resident_bytes()
+   call MPI_Allreduce(MPI_IN_PLACE, peak, 1, MPI_INTEGER8, MPI_MAX, MPI_COMM_WORLD)
+   nodes = solver%grid%node_count
+   call MPI_Allreduce(MPI_IN_PLACE, nodes, 1, MPI_INTEGER8, MPI_SUM, MPI_COMM_WORLD)
+   if (rank == 0) write (output_unit, '(i0,1x,i0,1x,i0,1x,i0,1x,es12.5,1x,es12.5,1x,f10.1,3(1x,i0),1x,es12.5)') &
+      scene%grid%dim, n_ranks, diag%particles, steps, t1 - t0, real(diag%particles, rp) * steps / ((t1 - t0) * n_ranks), &
+      (rss_after - rss_before) / max(1, solver%particles%count), peak, nodes, solver%relayouts, cpu
    if (command_argument_count() == 3) call time_output((t1 - t0) / steps)
    call solver%free()
    call MPI_Finalize()

@@ -8,7 +8,8 @@
 !> and slab boundaries, which load balancing may have moved). Restarting on the same number of ranks
 !> adopts the written decomposition and restores every rank's particles in their order, so the
 !> continued run is bitwise identical to an uninterrupted one; on another number the particles are
-!> redistributed by position over the uniform decomposition and re-sorted (equal to round-off).
+!> redistributed by position over a uniform split of an active box laid out around them, and
+!> re-sorted (equal to round-off).
 !>
 !> A checkpoint is written as `<name>.tmp`, synced to disk, and renamed only when complete; it carries
 !> a format name and version, and an attribute `complete` written last. Reading checks all of these
@@ -22,8 +23,7 @@ module checkpoint
    use mpm_solver, only: solver_t
    use domain_decomposition, only: valid_layout
    use world_frame, only: frame_t, place_grid
-   use particle_sorting, only: update_cells, sort_by_material_and_cell
-   use particle_redistribution, only: redistribute_particles
+   use particle_sorting, only: update_cells
    use hdf5_file, only: hdf5_file_t, slab_t, distributed_slab, even_slab
    use xdmf_writer, only: output_entry_t
    use run_progress, only: run_progress_t
@@ -36,7 +36,8 @@ module checkpoint
 
    !> Identification of the file format; a reader accepts exactly this version.
    character(len=*), parameter, public :: checkpoint_format = 'flotsam checkpoint'
-   !> 2: grid rotation; 3: cuts sized (ranks + 1) x 3 for any rank grid (load balancing)
+   !> 2: grid rotation; 3: cuts sized (ranks + 1) x 3 for any rank grid (load balancing); their ends, the
+   !> active box, need not be the grid's (a version-3 file of the whole grid is read the same way)
    integer, parameter, public :: checkpoint_format_version = 3
 
    public :: write_checkpoint, read_checkpoint, latest_checkpoint_path
@@ -343,10 +344,9 @@ contains
       else
          solver%lost_particles = merge(int(sum(lost)), 0, rank == 0)
          solver%wall_corrections = merge(int(sum(corrections)), 0, rank == 0)
-         call redistribute_particles(solver%domain, solver%grid, solver%particles, status)
+         ! the active box around the particles read, each sent to its owner
+         call solver%cover_particles(status)
          if (.not. status%ok) return
-         call update_cells(solver%grid, solver%particles)
-         call sort_by_material_and_cell(solver%grid, solver%particles)
       end if
       progress%next_output_time = next_output_time
       progress%restarted = .true.

@@ -5,8 +5,9 @@
 !>   /grid/node    nodal mass and velocity on the nodes of the active box of cells
 !>   /grid/cell    per material: cell averages of density and mean stress over the active box
 !>
-!> The active box is the smallest box of cells holding every particle. A state with a particle outside
-!> the grid (a blow-up written for inspection) gets no grid fields. Nodal values are those of a
+!> The active box is the smallest box of cells holding every particle; it lies inside the active region
+!> of the decomposition (the cells allocated), so output cost follows the particles too. A state with a
+!> particle outside the grid (a blow-up written for inspection) gets no grid fields. Nodal values are those of a
 !> particle-to-grid transfer of the current state (the solver's next step repeats it, so writing does
 !> not change the solution). A grid node belongs to the rank owning the cell of which it is the lower
 !> corner; the nodes on the upper faces of the box belong to the ranks owning the last cells.
@@ -208,7 +209,8 @@ contains
       call MPI_Allreduce(MPI_IN_PLACE, inside, 1, MPI_LOGICAL, MPI_LAND, solver%domain%comm)
    end function positions_in_grid
 
-   !> Smallest box of global cells holding every particle (the whole grid when there are none). Collective.
+   !> Smallest box of global cells holding every particle (the decomposition's active region when there
+   !> are none: no other cells are allocated). Collective.
    subroutine active_box(solver, box_lo, box_hi)
       type(solver_t), intent(in) :: solver
       integer, intent(out) :: box_lo(3), box_hi(3)
@@ -223,10 +225,7 @@ contains
       end do
       call MPI_Allreduce(MPI_IN_PLACE, box_lo, 3, MPI_INTEGER, MPI_MIN, solver%domain%comm)
       call MPI_Allreduce(MPI_IN_PLACE, box_hi, 3, MPI_INTEGER, MPI_MAX, solver%domain%comm)
-      if (box_hi(1) < 0) then
-         box_lo = 0
-         box_hi = solver%grid%global_cells - 1
-      end if
+      if (box_hi(1) < 0) call solver%domain%region(box_lo, box_hi)
       box_lo(dim + 1:) = 0
       box_hi(dim + 1:) = 0
    end subroutine active_box

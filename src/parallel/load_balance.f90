@@ -6,20 +6,18 @@
 !> equal a count as whole layers allow (at least two layers each: the smoothing's halo is two cells
 !> deep). Every rank grid whose slabs can be that wide is tried (for 2 ranks in 2-D: split x or split
 !> y), the particles are counted per box of each, and the one with the smallest largest box wins. All
-!> of it is integer arithmetic on reduced counts, so every rank picks the same layout.
+!> of it is integer arithmetic on reduced counts, so every rank picks the same layout. The slabs split
+!> the active region (domain_decomposition), not the whole grid.
 module load_balance
    use kinds, only: i8
    use mpi_f08, only: MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER8, MPI_SUM
-   use domain_decomposition, only: domain_t
+   use domain_decomposition, only: domain_t, min_slab_width
    use background_grid, only: grid_t
    use particle_set, only: particle_set_t
    implicit none
    private
 
-   !> Fewest cell layers in a slab of a split axis.
-   integer, parameter, public :: min_slab_width = 2
-
-   public :: split_counts, rank_grids, balanced_layout
+   public :: min_slab_width, split_counts, rank_grids, balanced_layout
 
 contains
 
@@ -57,9 +55,9 @@ contains
    end function split_counts
 
    !> The rank grids dims(1:3) with product nranks (1 beyond `dim`) in which every split axis has at
-   !> least min_slab_width cells per slab, as columns of grids(3, :).
-   pure function rank_grids(nranks, dim, global_cells) result(grids)
-      integer, intent(in) :: nranks, dim, global_cells(3)
+   !> least min_slab_width cells per slab (of `cells` along each axis), as columns of grids(3, :).
+   pure function rank_grids(nranks, dim, cells) result(grids)
+      integer, intent(in) :: nranks, dim, cells(3)
       integer, allocatable :: grids(:, :)
       integer :: a, b, c
       allocate (grids(3, 0))
@@ -75,32 +73,38 @@ contains
    contains
       pure logical function fits(d, k)
          integer, intent(in) :: d, k
-         fits = d == 1 .or. min_slab_width * d <= global_cells(k)
+         fits = d == 1 .or. min_slab_width * d <= cells(k)
       end function fits
    end function rank_grids
 
-   !> The layout (cuts as domain%cuts) that minimises the largest number of particles on one rank, and
-   !> that number. Among equally good layouts the current rank grid is kept. Collective: two
+   !> The layout (cuts as domain%cuts) of the active region lo..hi (default: the current one) that
+   !> minimises the largest number of particles on one rank, and that number. Among equally good
+   !> layouts the current rank grid is kept. Every particle must lie in the box. Collective: two
    !> reductions, the per-layer histograms and the box counts of every candidate rank grid.
-   subroutine balanced_layout(domain, grid, particles, cuts, largest)
+   subroutine balanced_layout(domain, grid, particles, cuts, largest, lo, hi)
       type(domain_t), intent(in) :: domain
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(in) :: particles
       integer, intent(out) :: cuts(0:domain%nranks, 3)
       integer(i8), intent(out) :: largest
+      integer, intent(in), optional :: lo(3), hi(3)
       integer, allocatable :: grids(:, :), cell(:, :), slab(:, :), candidate_cuts(:, :, :)
       integer(i8), allocatable :: histogram(:), loads(:, :)
-      integer :: first(3), n(3), c(3), k, g, p, box, best, stride
+      integer :: first(3), n(3), c(3), k, g, p, box, best, stride, box_lo(3), box_hi(3)
       integer(i8) :: worst
 
-      n = domain%global_cells
+      call domain%region(box_lo, box_hi)
+      if (present(lo)) box_lo = lo
+      if (present(hi)) box_hi = hi
+      ! layers are counted from the box's first (cell - box_lo)
+      n = box_hi - box_lo + 1
       first = [0, n(1), n(1) + n(2)]
       allocate (histogram(sum(n)), cell(3, particles%count))
       histogram = 0
       do p = 1, particles%count
          c = grid%cell_of_position(particles%x(:, p))
          cell(:, p) = 0
-         cell(1:domain%dim, p) = min(max(c(1:domain%dim), 0), n(1:domain%dim) - 1)
+         cell(1:domain%dim, p) = min(max(c(1:domain%dim) - box_lo(1:domain%dim), 0), n(1:domain%dim) - 1)
          do k = 1, domain%dim
             histogram(first(k) + cell(k, p) + 1) = histogram(first(k) + cell(k, p) + 1) + 1
          end do
@@ -144,7 +148,10 @@ contains
             best = g
          end if
       end do
-      cuts = candidate_cuts(:, :, best)
+      cuts = 0
+      do k = 1, 3
+         cuts(0:grids(k, best), k) = box_lo(k) + candidate_cuts(0:grids(k, best), k, best)
+      end do
       largest = worst
    end subroutine balanced_layout
 end module load_balance

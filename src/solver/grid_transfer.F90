@@ -49,23 +49,33 @@ contains
    !>   x_p := x_p + dt sum N v_i^{n+theta}                                             (if update_position)
    !> `strain_velocity`, when present, replaces v^{n+theta} in L (MUSL: the re-mapped velocities).
    !> `compute_spin` (default: as compute_strain) = .false. leaves the spin alone: only solids use it.
+   !> `extent` returns the lowest (:, 1) and highest (:, 2) new position along each axis (with
+   !> update_position; 0 beyond dim): the active region's check needs it, and here it costs no pass.
    subroutine grid_to_particles(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
-                                update_position, strain_velocity, compute_spin)
+                                update_position, strain_velocity, compute_spin, extent)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
       real(rp), intent(in) :: dt, flip_fraction, theta
       logical, intent(in) :: update_velocity, compute_strain, update_position
       real(rp), intent(in), optional :: strain_velocity(:, :)
       logical, intent(in), optional :: compute_spin
+      real(rp), intent(out), optional :: extent(3, 2)
+      real(rp) :: lo(3), hi(3)
       logical :: spin
       spin = compute_strain
       if (present(compute_spin)) spin = compute_strain .and. compute_spin
+      lo = 0.0_rp
+      hi = 0.0_rp
       if (grid%dim == 2) then
          call grid_to_particles_2d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
-                                   spin, update_position, strain_velocity)
+                                   spin, update_position, lo(1:2), hi(1:2), strain_velocity)
       else
          call grid_to_particles_3d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
-                                   spin, update_position, strain_velocity)
+                                   spin, update_position, lo, hi, strain_velocity)
+      end if
+      if (present(extent)) then
+         extent(:, 1) = lo
+         extent(:, 2) = hi
       end if
    end subroutine grid_to_particles
 

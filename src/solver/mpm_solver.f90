@@ -7,14 +7,16 @@
 !>   4. grid -> particles: L_p, FLIP/PIC velocity, positions (MUSL: re-map before L)
 !>   5. filter part A (d -> d~), constitutive update per material, filter part B (sbar -> sbar~)
 !>   6. wall safeguard, inflow, migration to owning ranks, sort by (material, cell), next dt.
+!>   7. the active region follows the particles (active_region): a new layout when they near its edge.
 !> Everything runs in the grid's frame; the scene (world frame) is mapped into it once, in init.
 module mpm_solver
    use kinds, only: rp, i8
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_Allgather, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_MIN, &
                       MPI_INTEGER8
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use error_status, only: status_t
    use scene_description, only: scene_t, run_control_t, wall_spec_t
-   use domain_decomposition, only: domain_t
+   use domain_decomposition, only: domain_t, layout_dims, fit_box
    use load_balance, only: balanced_layout
    use particle_redistribution, only: redistribute_particles
    use background_grid, only: grid_t, row_mass
@@ -28,12 +30,14 @@ module mpm_solver
    use newtonian_fluid, only: newtonian_fluid_t
    use stabilizer, only: stabilizer_slot_t, stage_context_t
    use stabilizer_factory, only: build_stabilizers
-   use volume_correction, only: volume_corrector_t
+   use volume_correction, only: volume_corrector_t, max_shift_in_cells
    use boundary_walls, only: wall_t, build_walls, set_wall_activity, apply_wall_constraints, keep_particles_inside
    use fluid_inflow, only: inlet_t, build_inlets
    use world_frame, only: frame_t, place_grid
    use grid_transfer, only: particles_to_grid, update_velocity_and_remap, grid_to_particles
    use run_diagnostics, only: diagnostics_t, compute_diagnostics
+   use active_region, only: scene_extent, particle_extent, cells_of_extent, guard_cells, box_needs_change, target_box, &
+                            slack_cells
    use status_broadcast, only: agree_on_status
    use phase_timers, only: phase_timers_t, phase_particles_to_grid, phase_grid_update, phase_walls, &
                            phase_stabilization, phase_grid_to_particles, phase_constitutive, phase_inflow, &
@@ -64,6 +68,8 @@ module mpm_solver
       real(rp) :: mass_tolerance = 0.0_rp       !< nodes lighter than this carry no velocity
       logical :: musl = .false.
       real(rp), allocatable :: remapped_momentum(:, :)
+      real(rp) :: extent(3, 2) = 0.0_rp         !< lowest and highest particle position after the last move
+      integer :: relayouts = 0                  !< layouts made because the particles outgrew the active region
       type(phase_timers_t) :: timers            !< wall time per phase (the time loop adds its own phases)
    contains
       procedure :: init => solver_init
@@ -72,6 +78,7 @@ module mpm_solver
       procedure :: diagnostics => solver_diagnostics
       procedure :: balance_load => solver_balance_load
       procedure :: set_layout => solver_set_layout
+      procedure :: cover_particles => solver_cover_particles
       procedure :: free => solver_free
    end type solver_t
 
@@ -89,8 +96,8 @@ contains
       real(rp) :: min_mass
       type(frame_t) :: frame
       logical :: seed
-      integer :: dim, grid_cells(3), i
-      real(rp) :: grid_origin(3)
+      integer :: dim, grid_cells(3), i, need_lo(3), need_hi(3), box_lo(3), box_hi(3)
+      real(rp) :: grid_origin(3), x_lo(3), x_hi(3)
 
       dim = scene%grid%dim
       self%scene = scene
@@ -99,7 +106,15 @@ contains
       call place_grid(scene%grid, frame, grid_origin, grid_cells)
       self%gravity = 0.0_rp
       self%gravity(1:dim) = frame%grid_vector(scene%gravity(1:dim))
-      call self%domain%init(comm, dim, grid_cells, status)
+      ! the active region starts at the bodies and inlets: the empty rest of the grid is never allocated
+      call scene_extent(scene, frame, scene%grid%cell_size, 0.0_rp, .true., x_lo, x_hi)
+      call cells_of_extent(grid_origin, 1.0_rp / scene%grid%cell_size, grid_cells, dim, x_lo, x_hi, need_lo, need_hi)
+      if (any(need_lo(1:dim) > need_hi(1:dim))) then
+         need_lo = 0
+         need_hi = 0
+      end if
+      call target_box(need_lo, need_hi, guard_cells(1.0_rp) + slack_cells, grid_cells, dim, box_lo, box_hi)
+      call self%domain%init(comm, dim, grid_cells, status, box_lo, box_hi)
       if (.not. status%ok) return
       call self%grid%init(self%domain, grid_origin, scene%grid%cell_size, frame)
       call build_materials(scene%materials, self%materials, status)
@@ -167,23 +182,75 @@ contains
       if (largest < maxval(counts)) call self%set_layout(cuts, status)
    end subroutine solver_balance_load
 
-   !> Adopt the decomposition `cuts` (as domain%cuts; the rank grid may change): the particles go to
-   !> their new owners, the grid, the walls' node lists and the node arrays are made for the new box.
-   !> The stabilizers size their cell arrays to the grid when they next run. Collective.
-   subroutine solver_set_layout(self, cuts, status)
+   !> Adopt the decomposition `cuts` (as domain%cuts; the rank grid and the active region may change): the
+   !> particles go to their new owners, the grid, the walls' node lists and the node arrays are made for
+   !> the new box. When only the outer ends of the slabs move (the active region follows the particles) no
+   !> particle changes rank and the particles keep their order. With `moved` (particles read from a
+   !> checkpoint of another rank count) every particle is sent to its owner. The stabilizers size their
+   !> cell arrays to the grid when they next run. Collective.
+   subroutine solver_set_layout(self, cuts, status, moved)
       class(solver_t), intent(inout) :: self
       integer, intent(in) :: cuts(0:, :)
       type(status_t), intent(inout) :: status
+      logical, intent(in), optional :: moved
+      logical :: same_owners
+      integer :: k, d
+      same_owners = all(layout_dims(cuts) == self%domain%dims)
+      do k = 1, 3
+         d = self%domain%dims(k)
+         if (same_owners) same_owners = all(cuts(1:d - 1, k) == self%domain%cuts(1:d - 1, k))
+      end do
+      if (present(moved)) same_owners = same_owners .and. .not. moved
       call self%domain%set_layout(cuts)
-      call redistribute_particles(self%domain, self%grid, self%particles, status)
-      if (.not. status%ok) return
+      if (.not. same_owners) then
+         call redistribute_particles(self%domain, self%grid, self%particles, status)
+         if (.not. status%ok) return
+      end if
       call self%grid%init(self%domain, self%grid%origin, self%grid%h, self%grid%frame)
       call build_boundaries(self)
       call self%volume%reset_grid()
       call update_cells(self%grid, self%particles)
-      call sort_by_material_and_cell(self%grid, self%particles)
+      if (.not. same_owners) call sort_by_material_and_cell(self%grid, self%particles)
       call size_node_arrays(self)
    end subroutine solver_set_layout
+
+   !> Lay the active region out around the particles wherever they are (all inside the grid), on this rank
+   !> grid, and send every particle to its owner: the particles read from a checkpoint written on another
+   !> number of ranks. Collective.
+   subroutine solver_cover_particles(self, status)
+      class(solver_t), intent(inout) :: self
+      type(status_t), intent(inout) :: status
+      real(rp) :: extent(6)
+      integer :: dim, need_lo(3), need_hi(3), box_lo(3), box_hi(3), cuts(0:self%domain%nranks, 3)
+      logical :: kept
+      dim = self%grid%dim
+      call particle_extent(self%particles, extent(1:3), extent(4:6))
+      extent(4:6) = -extent(4:6)
+      call MPI_Allreduce(MPI_IN_PLACE, extent, 6, MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
+      call needed_cells(self, extent(1:3), -extent(4:6), need_lo, need_hi)
+      call target_box(need_lo, need_hi, guard_cells(1.0_rp) + slack_cells, self%grid%global_cells, dim, box_lo, box_hi)
+      call fit_box(self%domain%dims, self%grid%global_cells, box_lo, box_hi)
+      call self%domain%box_cuts(box_lo, box_hi, cuts, kept)
+      call self%set_layout(cuts, status, moved=.true.)
+   end subroutine solver_cover_particles
+
+   !> The cells lo..hi the active region must hold: those of the particles' extent x_lo..x_hi (all ranks)
+   !> and of the inlets still to inject. The cell 0 if there is nothing (an empty box is not a layout).
+   subroutine needed_cells(self, x_lo, x_hi, lo, hi)
+      type(solver_t), intent(in) :: self
+      real(rp), intent(in) :: x_lo(3), x_hi(3)
+      integer, intent(out) :: lo(3), hi(3)
+      real(rp) :: inlet_lo(3), inlet_hi(3)
+      integer :: dim
+      dim = self%grid%dim
+      call scene_extent(self%scene, self%grid%frame, self%grid%h, self%time, .false., inlet_lo, inlet_hi)
+      call cells_of_extent(self%grid%origin, self%grid%inv_h, self%grid%global_cells, dim, &
+                           min(x_lo, inlet_lo), max(x_hi, inlet_hi), lo, hi)
+      if (any(lo(1:dim) > hi(1:dim))) then
+         lo = 0
+         hi = 0
+      end if
+   end subroutine needed_cells
 
    !> One explicit step of length self%dt; afterwards self%dt holds the next stable step.
    subroutine solver_advance(self)
@@ -235,16 +302,20 @@ contains
             call remap_velocities(self)
             call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
                                    update_velocity=.false., compute_strain=.true., update_position=.true., &
-                                   strain_velocity=self%remapped_momentum, compute_spin=spin_needed)
+                                   strain_velocity=self%remapped_momentum, compute_spin=spin_needed, &
+                                   extent=self%extent)
          else
             call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
                                    update_velocity=.true., compute_strain=.true., update_position=.true., &
-                                   compute_spin=spin_needed)
+                                   compute_spin=spin_needed, extent=self%extent)
          end if
       end associate
       if (self%volume%shifting_now) then
          call self%timers%switch_to(phase_volume_correction)
          call self%volume%apply_shifts(self%particles)
+         ! the shifts come after the extent was taken: widen it by their largest length
+         self%extent(:, 1) = self%extent(:, 1) - max_shift_in_cells * self%grid%h
+         self%extent(:, 2) = self%extent(:, 2) + max_shift_in_cells * self%grid%h
       end if
 
       call self%timers%switch_to(phase_stabilization)
@@ -294,7 +365,7 @@ contains
       self%time = self%time + dt
       self%step = self%step + 1
       call self%timers%switch_to(phase_time_step)
-      self%dt = self%stable_time_step()
+      call follow_particles(self)
       call self%timers%switch_to(phase_other)
 
    contains
@@ -371,15 +442,32 @@ contains
 
    !> dt = CFL h / (sqrt(dim) max_p (c_p + |v_p|)), limited by the viscous step CFL rho h^2 / (2 dim mu)
    !> (algorithms.md section 5.4), or the fixed dt of &run. Collective (global minimum).
-   !> An inlet that is not closed yet counts as a particle of its fluid at rho0 moving at v0: the step
-   !> must resolve the fluid it is about to create (and an empty tank must not take a huge step).
    real(rp) function solver_stable_time_step(self) result(dt)
       class(solver_t), intent(inout) :: self
-      real(rp) :: speed, h
-      integer :: m, first, last, i
-      h = self%grid%h
+      real(rp) :: speed
+      call local_time_step(self, dt, speed)
+      call MPI_Allreduce(MPI_IN_PLACE, dt, 1, MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
+   end function solver_stable_time_step
+
+   !> This rank's stable step (see solver_stable_time_step) and a bound `speed` [m/s] on how fast its
+   !> particles move: the largest signal speed c + |v| of its particles and open inlets, or with a fixed
+   !> step a bound on the largest |v| (the sound speed is not needed then, and a blowing-up state may
+   !> have no valid one). An inlet that is not closed yet counts as a particle of its fluid at rho0 moving at
+   !> v0: the step must resolve the fluid it is about to create (and an empty tank must not take a huge
+   !> step).
+   subroutine local_time_step(self, dt, speed)
+      type(solver_t), intent(in) :: self
+      real(rp), intent(out) :: dt, speed
+      integer :: m, first, last, i, n
+      n = self%particles%count
       if (self%run%fixed_dt > 0.0_rp) then
          dt = self%run%fixed_dt
+         speed = 0.0_rp
+         ! sqrt(dim) max |v_k| >= |v|, without squares that could overflow in a blowing-up state
+         if (n > 0) speed = sqrt(real(self%grid%dim, rp)) * maxval(abs(self%particles%v(:, 1:n)))
+         do i = 1, size(self%inlets)
+            if (self%time < self%inlets(i)%spec%end_time) speed = max(speed, self%inlets(i)%spec%velocity)
+         end do
          return
       end if
       speed = 0.0_rp
@@ -398,10 +486,53 @@ contains
                                                           [self%grid%dim, 1])))
          end associate
       end do
-      if (speed > 0.0_rp) dt = self%run%cfl * h / (sqrt(real(self%grid%dim, rp)) * speed)
+      if (speed > 0.0_rp) dt = self%run%cfl * self%grid%h / (sqrt(real(self%grid%dim, rp)) * speed)
       dt = min(dt, viscous_time_step(self))
-      call MPI_Allreduce(MPI_IN_PLACE, dt, 1, MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
-   end function solver_stable_time_step
+   end subroutine local_time_step
+
+   !> The next time step, and a new layout if the particles outgrew the active region or it became too big
+   !> for them (active_region). One reduction for both: the step, the largest signal speed and the
+   !> particles' extent travel together (there is no other reduction per step for the box). Collective.
+   subroutine follow_particles(self)
+      type(solver_t), intent(inout) :: self
+      real(rp) :: values(8), speed
+      integer :: dim, need_lo(3), need_hi(3), box_lo(3), box_hi(3), target_lo(3), target_hi(3), guard, margin
+      integer :: cuts(0:self%domain%nranks, 3)
+      integer(i8) :: largest
+      logical :: kept
+      type(status_t) :: status
+
+      dim = self%grid%dim
+      ! all as minima: [dt, -speed, lo(1:3), -hi(1:3)]. The extent is that of the positions the step
+      ! computed (no pass of its own): the safeguard then moves particles only back behind walls, by less
+      ! than the step's travel, and inlets inject into their openings, which the region covers anyway.
+      call local_time_step(self, values(1), speed)
+      values(2) = -speed
+      values(3:5) = self%extent(:, 1)
+      values(6:8) = -self%extent(:, 2)
+      call MPI_Allreduce(MPI_IN_PLACE, values, size(values), MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
+      self%dt = values(1)
+      speed = -values(2)
+
+      ! a state that is no longer finite is the health check's business, not the layout's
+      if (.not. all(ieee_is_finite(values))) return
+      call needed_cells(self, values(3:5), -values(6:8), need_lo, need_hi)
+      guard = guard_cells(self%dt * speed * self%grid%inv_h)
+      margin = guard + slack_cells
+      call target_box(need_lo, need_hi, margin, self%grid%global_cells, dim, target_lo, target_hi)
+      call fit_box(self%domain%dims, self%grid%global_cells, target_lo, target_hi)
+      call self%domain%region(box_lo, box_hi)
+      if (.not. box_needs_change(box_lo, box_hi, need_lo, need_hi, guard, margin, target_lo, target_hi, &
+                                 self%grid%global_cells, dim)) return
+
+      call self%domain%box_cuts(target_lo, target_hi, cuts, kept)
+      ! an axis that had to be split anew is split by particle count, as load balancing would
+      if (.not. kept .and. self%domain%nranks > 1 .and. self%run%rebalance_threshold > 0.0_rp) &
+         call balanced_layout(self%domain, self%grid, self%particles, cuts, largest, target_lo, target_hi)
+      ! every particle lies in the grid after migration, so the redistribution cannot fail
+      call self%set_layout(cuts, status)
+      self%relayouts = self%relayouts + 1
+   end subroutine follow_particles
 
    !> CFL rho0 h^2 / (2 dim mu) over the viscous fluids present.
    real(rp) function viscous_time_step(self) result(dt)

@@ -47,8 +47,8 @@ module volume_correction
    !> The shifting runs every k steps with k D per application, k the largest with k D <= this: the
    !> crowding builds over thousands of steps, so a k-th of the cost buys the same correction.
    real(rp), parameter :: coefficient_per_application = 0.2_rp
-   !> Largest shift per application, in cells.
-   real(rp), parameter :: max_shift_in_cells = 0.1_rp
+   !> Largest shift per application, in cells (public: the active region widens the particles' extent by it).
+   real(rp), parameter, public :: max_shift_in_cells = 0.1_rp
 
    type, public :: volume_corrector_t
       real(rp), allocatable :: shifting_coefficient(:)  !< per material: D, 0 without shifting

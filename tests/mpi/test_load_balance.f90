@@ -3,6 +3,7 @@
 !> rebalance_interval steps). The diagnostics agree to round-off (relative 1e-10, as between rank
 !> counts: only the order of the particle-grid sums changes), the layout did change, and afterwards the
 !> largest rank holds at most 60 % of the particles on 2 ranks (a lower share than without on more).
+!> Without rebalancing the slabs of the active region keep their inner cuts (section 6.2).
 module test_load_balance
    use kinds, only: rp, i8
    use mpi_f08, only: MPI_Comm, MPI_Comm_size
@@ -12,7 +13,8 @@ module test_load_balance
    use mpm_solver, only: solver_t
    use run_diagnostics, only: diagnostics_t
    use input_text, only: real_text
-   use test_scenes, only: water_scene, add_body, tank_with_inlet
+   use test_scenes, only: tank_with_inlet, corner_column
+   use time_loop_steps, only: start_run, step_run
    implicit none
    private
 
@@ -22,19 +24,18 @@ module test_load_balance
 
 contains
 
-   !> A 1 m x 1 m water column in the corner of a 4 m x 2 m box: on 2 ranks (split along x at 2 m)
-   !> all particles start on rank 0. Standard MPM and each stabilization scheme (their cell arrays
-   !> follow the new box).
+   !> A 1 m x 1 m water column in the corner of a 4 m x 2 m box. The active region starts at the column,
+   !> split evenly; as the column collapses to the right the region grows with the last slab, which
+   !> gathers the water (without rebalancing the largest rank holds 68 % on 2 ranks, 49 % on 4 after
+   !> 200 steps). Standard MPM and each stabilization scheme (their cell arrays follow the new box).
    subroutine test_collapsing_column_rebalanced(comm)
       type(MPI_Comm), intent(in) :: comm
       character(len=5), parameter :: schemes(4) = [character(len=5) :: 'none', 'C0', 'NB', 'FOAL1']
       type(scene_t) :: scene
       integer :: i
       do i = 1, size(schemes)
-         scene = water_scene(2, 0.05_rp, [4.0_rp, 2.0_rp, 0.0_rp], 2.0e6_rp, 9.81_rp)
-         call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [1.0_rp, 1.0_rp, 0.0_rp], 2, .false., 0.0_rp)
+         scene = corner_column([4.0_rp, 2.0_rp], 1.0_rp, schemes(i))
          scene%run%fixed_dt = 5.0e-4_rp
-         scene%materials(1)%stabilization = schemes(i)
          call compare_with_and_without(comm, scene, 'collapsing column, '//trim(schemes(i)))
       end do
    end subroutine test_collapsing_column_rebalanced
@@ -85,8 +86,8 @@ contains
          call assertTrue(all(cuts_on == cuts_off), 'one rank: nothing to balance'//what)
          return
       end if
-      call assertTrue(off%max_rank_share > 0.99_rp, 'without rebalancing one rank holds (nearly) all, share '// &
-                      real_text(off%max_rank_share)//what)
+      call assertTrue(off%max_rank_share > 1.3_rp / nranks, 'without rebalancing one rank holds more than 1.3 times '// &
+                      'its share, share '//real_text(off%max_rank_share)//what)
       call assertTrue(any(cuts_on /= cuts_off), 'rebalancing moved the cuts'//what)
       call assertTrue(on%max_rank_share < off%max_rank_share, 'rebalanced share '//real_text(on%max_rank_share)// &
                       ' below '//real_text(off%max_rank_share)//what)
@@ -103,12 +104,10 @@ contains
       type(solver_t) :: solver
       type(status_t) :: status
       integer :: step
-      call solver%init(scene, comm, status)
+      call start_run(solver, scene, comm, status)
       call assertTrue(status%ok, 'solver init: '//trim(status%message))
-      call solver%balance_load(status)
       do step = 1, n_steps
-         call solver%advance()
-         if (mod(solver%step, int(scene%run%rebalance_interval, i8)) == 0) call solver%balance_load(status)
+         call step_run(solver, status)
       end do
       call assertTrue(status%ok, 'balance: '//trim(status%message))
       diag = solver%diagnostics()

@@ -6,7 +6,7 @@ module test_scenes
    implicit none
    private
 
-   public :: water_scene, add_body, tank_with_inlet
+   public :: water_scene, add_body, tank_with_inlet, corner_column
 
 contains
 
@@ -55,6 +55,17 @@ contains
       body%free_surface_level = surface
       scene%bodies = [scene%bodies, body]
    end subroutine add_body
+
+   !> A square water column of side `side` in the lower left corner of a 2-D tank of `extent` with slip
+   !> walls (cell 0.05 m, K = 2 MPa, g = 9.81, 2 x 2 particles per cell), stabilized by `scheme`.
+   function corner_column(extent, side, scheme) result(scene)
+      real(rp), intent(in) :: extent(2), side
+      character(len=*), intent(in) :: scheme
+      type(scene_t) :: scene
+      scene = water_scene(2, 0.05_rp, [extent, 0.0_rp], 2.0e6_rp, 9.81_rp)
+      call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [side, side, 0.0_rp], 2, .false., 0.0_rp)
+      scene%materials(1)%stabilization = scheme
+   end function corner_column
 
    !> A 2-D tank 3 m x 2 m (cell 0.1 m, K = 2 MPa, g = 10) with a floor and a right wall, filled through
    !> an opening of `height` at the foot of the left wall (a slip wall above it): water enters at

@@ -1,6 +1,7 @@
 !> Tests of src/io/checkpoint.f90: a run continued from a checkpoint on the same ranks is bitwise the
 !> uninterrupted run; on another number of ranks equal to round-off; checkpoints of another scene or
-!> format version are refused; only the newest checkpoints are kept.
+!> format version are refused; only the newest checkpoints are kept. Both restarts also from an active
+!> region that has moved with the particles (cuts that do not span the grid).
 module test_checkpoint
    use kinds, only: rp, i8
    use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_size, MPI_Comm_split, MPI_Comm_free, MPI_Bcast, &
@@ -23,6 +24,7 @@ module test_checkpoint
    private
 
    public :: test_restart_on_same_ranks_is_bitwise, test_restart_with_foal1_is_bitwise, test_restart_on_other_rank_count, &
+             test_restart_of_moved_region_is_bitwise, test_moved_region_on_other_rank_count, &
              test_checkpoint_of_other_scene_is_refused, test_other_format_version_is_refused, &
              test_only_newest_checkpoints_are_kept
 
@@ -40,12 +42,25 @@ contains
       scene%run%output_dir = dir
    end function column_scene
 
+   !> A free block of water (no gravity) crossing the 4 m x 2 m box at (40, 10) m/s: the active region
+   !> has been laid out anew before the checkpoint and is again after it, its slabs do not reach the
+   !> grid's edges.
+   function travelling_scene(dir) result(scene)
+      character(len=*), intent(in) :: dir
+      type(scene_t) :: scene
+      scene = water_scene(2, 0.05_rp, [4.0_rp, 2.0_rp, 0.0_rp], 2.0e6_rp, 0.0_rp)
+      call add_body(scene, 1, [0.5_rp, 0.5_rp, 0.0_rp], [1.0_rp, 1.0_rp, 0.0_rp], 2, .false., 0.0_rp)
+      scene%bodies(1)%velocity = [40.0_rp, 10.0_rp, 0.0_rp]
+      scene%run%output_dir = dir
+   end function travelling_scene
+
    !> Run `steps_before` steps, write a checkpoint into `dir` (path returned), run `steps_after` more.
-   subroutine run_with_checkpoint(scene, comm, solver, path)
+   subroutine run_with_checkpoint(scene, comm, solver, path, layouts)
       type(scene_t), intent(in) :: scene
       type(MPI_Comm), intent(in) :: comm
       type(solver_t), intent(inout) :: solver
       character(len=:), allocatable, intent(out) :: path
+      integer, intent(out), optional :: layouts           !< of the active region, before the checkpoint
       type(status_t) :: status
       type(run_progress_t) :: progress
       type(output_entry_t) :: entry
@@ -62,6 +77,7 @@ contains
       entry%grid_origin = [0.0_rp, 0.25_rp, 0.0_rp]
       call progress%add_output(entry)
       progress%next_output_time = 0.1_rp
+      if (present(layouts)) layouts = solver%relayouts
       call write_checkpoint(solver, progress, scene%run%output_dir, 2, path, status)
       call assertTrue(status%ok, 'write_checkpoint: '//trim(status%message))
       do step = 1, steps_after
@@ -83,17 +99,26 @@ contains
       call check_bitwise_restart(comm, scene)
    end subroutine test_restart_with_foal1_is_bitwise
 
-   subroutine check_bitwise_restart(comm, scene)
+   !> The checkpoint of a moved active region (cuts that do not span the grid) continues bitwise.
+   subroutine test_restart_of_moved_region_is_bitwise(comm)
+      type(MPI_Comm), intent(in) :: comm
+      call check_bitwise_restart(comm, travelling_scene('moved_region'), region_moves=.true.)
+   end subroutine test_restart_of_moved_region_is_bitwise
+
+   subroutine check_bitwise_restart(comm, scene, region_moves)
       type(MPI_Comm), intent(in) :: comm
       type(scene_t), intent(in) :: scene
+      logical, intent(in), optional :: region_moves
       type(solver_t) :: uninterrupted, restarted
       type(run_progress_t) :: progress
       type(status_t) :: status
       type(diagnostics_t) :: a, b
       character(len=:), allocatable :: path
-      integer :: step, n
+      integer :: step, n, layouts_at_checkpoint
 
-      call run_with_checkpoint(scene, comm, uninterrupted, path)
+      call run_with_checkpoint(scene, comm, uninterrupted, path, layouts_at_checkpoint)
+      if (present(region_moves)) &
+         call assertTrue(layouts_at_checkpoint > 0, 'the region moved before the checkpoint')
       call restarted%init(scene, comm, status, seed_particles=.false.)
       call read_checkpoint(path, scene, restarted, progress, status)
       call assertTrue(status%ok, 'read_checkpoint: '//trim(status%message))
@@ -131,7 +156,18 @@ contains
    !> Written on all ranks of comm, continued on one rank fewer.
    subroutine test_restart_on_other_rank_count(comm)
       type(MPI_Comm), intent(in) :: comm
-      type(scene_t) :: scene
+      call check_restart_on_fewer_ranks(comm, column_scene('other_ranks'))
+   end subroutine test_restart_on_other_rank_count
+
+   !> The same with a moved active region: the fewer ranks lay a region out around the particles read.
+   subroutine test_moved_region_on_other_rank_count(comm)
+      type(MPI_Comm), intent(in) :: comm
+      call check_restart_on_fewer_ranks(comm, travelling_scene('moved_other_ranks'))
+   end subroutine test_moved_region_on_other_rank_count
+
+   subroutine check_restart_on_fewer_ranks(comm, scene)
+      type(MPI_Comm), intent(in) :: comm
+      type(scene_t), intent(in) :: scene
       type(solver_t) :: uninterrupted, restarted
       type(run_progress_t) :: progress
       type(status_t) :: status
@@ -143,7 +179,6 @@ contains
 
       call MPI_Comm_rank(comm, rank)
       call MPI_Comm_size(comm, n_ranks)
-      scene = column_scene('other_ranks')
       call run_with_checkpoint(scene, comm, uninterrupted, path)
       a = uninterrupted%diagnostics()
       call uninterrupted%free()
@@ -169,7 +204,8 @@ contains
       call assertRelativelyEqual(a%kinetic_energy, values(3), 1.0e-10_rp, 'kinetic energy')
       call assertRelativelyEqual(a%fluid_volume, values(4), 1.0e-10_rp, 'fluid volume')
       call assertRelativelyEqual(a%max_speed, values(5), 1.0e-10_rp, 'max speed')
-   end subroutine test_restart_on_other_rank_count
+      call assertEqual(0_i8, a%lost_particles, 'none lost')
+   end subroutine check_restart_on_fewer_ranks
 
    subroutine test_checkpoint_of_other_scene_is_refused(comm)
       type(MPI_Comm), intent(in) :: comm

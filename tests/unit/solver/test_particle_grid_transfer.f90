@@ -68,7 +68,7 @@ contains
       call particles_to_grid(solver%grid, solver%particles, solver%gravity)
       call sum_shared_nodes(solver%domain, solver%grid, solver%grid%accumulated)
       ! after the ghost-node sum a shared node holds the full value on every rank: count it once, on
-      ! the rank whose cells start at it (or at the grid's upper boundary)
+      ! the rank whose cells start at it (or at the upper boundary of the active region)
       node_sums = 0.0_rp
       do i = 1, solver%grid%node_count
          rest = i - 1
@@ -78,7 +78,8 @@ contains
          end do
          counted = .true.
          do k = 1, dim
-            if (g(k) > solver%grid%cell_hi(k) .and. g(k) < solver%grid%global_cells(k)) counted = .false.
+            if (g(k) > solver%grid%cell_hi(k) .and. &
+                g(k) < solver%domain%cuts(solver%domain%dims(k), k)) counted = .false.
          end do
          if (counted) node_sums(1:1 + 2 * dim) = node_sums(1:1 + 2 * dim) + solver%grid%accumulated(:, i)
       end do
