@@ -6,6 +6,7 @@
 !> run (including a blow-up); 5 stopped by SIGTERM/SIGINT after writing a checkpoint.
 program flotsam
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
+   use mpi_io_choice, only: prefer_romio
    use mpi_f08, only: MPI_Init, MPI_Finalize, MPI_Comm_rank, MPI_COMM_WORLD
    use kinds, only: path_len
    use error_status, only: status_t
@@ -31,6 +32,7 @@ program flotsam
    logical :: overwrite
    integer :: rank, exit_code, stopped_by
 
+   call prefer_romio()     ! before MPI_Init: see src/parallel/mpi_io_choice.f90
    call MPI_Init()
    call MPI_Comm_rank(MPI_COMM_WORLD, rank)
    call parse_command_line(scene_path, overrides, overwrite, restart_path, exit_code)

@@ -16,6 +16,7 @@
 program flotsam_bench
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use kinds, only: rp, i8
+   use mpi_io_choice, only: prefer_romio
    use mpi_f08, only: MPI_Init, MPI_Finalize, MPI_Comm_rank, MPI_Comm_size, MPI_Barrier, MPI_Wtime, MPI_COMM_WORLD, &
                       MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER, MPI_MAX, MPI_INTEGER8, MPI_SUM, MPI_DOUBLE_PRECISION
    use error_status, only: status_t
@@ -43,6 +44,7 @@ program flotsam_bench
    real(rp) :: t0, t1, rss_before, rss_after, cpu0, cpu1, cpu
    integer(i8) :: peak, nodes
 
+   call prefer_romio()     ! before MPI_Init: see src/parallel/mpi_io_choice.f90
    call MPI_Init()
    call MPI_Comm_rank(MPI_COMM_WORLD, rank)
    call MPI_Comm_size(MPI_COMM_WORLD, n_ranks)
