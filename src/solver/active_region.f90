@@ -28,13 +28,16 @@ contains
    !> Grid-frame extent lo..hi of what the scene will put into the grid from `time` on: with
    !> `bodies`, the boxes of the bodies (their corners mapped into the grid frame), and the openings of
    !> the inlets that have not closed, each with one cell downstream where its new layers appear
-   !> (fluid_inflow places them within v0 dt + Dp/2 of the opening). lo > hi if there is nothing.
-   pure subroutine scene_extent(scene, frame, h, time, bodies, lo, hi)
+   !> (fluid_inflow places them within v0 dt + Dp/2 of the opening). With `lead`, only the inlets that
+   !> open before time + lead: an inlet that opens later costs no grid until then (the check after every
+   !> step takes it in before its first layer). lo > hi if there is nothing.
+   pure subroutine scene_extent(scene, frame, h, time, bodies, lo, hi, lead)
       type(scene_t), intent(in) :: scene
       type(frame_t), intent(in) :: frame
       real(rp), intent(in) :: h, time
       logical, intent(in) :: bodies
       real(rp), intent(out) :: lo(3), hi(3)
+      real(rp), intent(in), optional :: lead
       real(rp), allocatable :: points(:, :)        ! world points to cover (3, n)
       real(rp) :: far_end(3), shift(3), g(3)
       integer :: dim, b, i, corner, n
@@ -58,6 +61,9 @@ contains
          do i = 1, size(scene%inlets)
             associate (inlet => scene%inlets(i))
                if (time >= inlet%end_time) cycle
+               if (present(lead)) then
+                  if (inlet%start_time > time + lead) cycle
+               end if
                far_end = opening_far_end(inlet, dim)
                shift = h * inlet%direction / norm2(inlet%direction(1:dim))
                points(:, n + 1:n + 4) = reshape([inlet%point, far_end, inlet%point + shift, far_end + shift], [3, 4])

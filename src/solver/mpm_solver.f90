@@ -243,7 +243,9 @@ contains
       real(rp) :: inlet_lo(3), inlet_hi(3)
       integer :: dim
       dim = self%grid%dim
-      call scene_extent(self%scene, self%grid%frame, self%grid%h, self%time, .false., inlet_lo, inlet_hi)
+      ! inlets opening within the next two steps (self%dt is the next step's): see scene_extent
+      call scene_extent(self%scene, self%grid%frame, self%grid%h, self%time, .false., inlet_lo, inlet_hi, &
+                        lead=2.0_rp * self%dt)
       call cells_of_extent(self%grid%origin, self%grid%inv_h, self%grid%global_cells, dim, &
                            min(x_lo, inlet_lo), max(x_hi, inlet_hi), lo, hi)
       if (any(lo(1:dim) > hi(1:dim))) then
