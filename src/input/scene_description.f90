@@ -81,7 +81,7 @@ module scene_description
       logical :: hydrostatic = .false.        !< new particles carry the hydrostatic pressure below the stream top
    end type inlet_spec_t
 
-   public :: opening_tangent, opening_far_end
+   public :: opening_tangent, opening_far_end, shifts_particles, relaxes_to_eos
 
    !> `&material`: one constitutive model and its parameters.
    type, public :: material_spec_t
@@ -98,7 +98,8 @@ module scene_description
       real(rp) :: gamma_max = 1.0_rp          !< FOAL1: flux tuning coefficient in [0, 1]
       character(len=name_len) :: smoothed_variables = 'stress'   !< FOAL1: 'stress' (all components) or 'pressure'
       logical :: cell_averaging = .true.      !< FOAL1: replace particle values by the cell average first
-      !> Fluid volume consistency (docs/volume-conservation.md): 'none', 'shifting' or 'eos_relaxation'
+      !> Fluid volume consistency (docs/volume-conservation.md): 'none', 'shifting', 'eos_relaxation' or
+      !> 'shifting+eos_relaxation' (read with shifts_particles / relaxes_to_eos)
       character(len=name_len) :: volume_correction = 'none'
       real(rp) :: shifting_coefficient = 0.02_rp   !< shifting: D in dx = -D h^2 grad(excess occupancy), per step
       real(rp) :: eos_relaxation_rate = 0.01_rp    !< eos_relaxation: fraction of p - p_EOS(rho) removed per step
@@ -129,6 +130,18 @@ module scene_description
    end type scene_t
 
 contains
+
+   !> The material's volume correction includes shifting (docs/volume-conservation.md).
+   pure logical function shifts_particles(material)
+      type(material_spec_t), intent(in) :: material
+      shifts_particles = index(material%volume_correction, 'shifting') > 0
+   end function shifts_particles
+
+   !> The material's volume correction includes the EOS relaxation: its fluid also starts in EOS states.
+   pure logical function relaxes_to_eos(material)
+      type(material_spec_t), intent(in) :: material
+      relaxes_to_eos = index(material%volume_correction, 'eos_relaxation') > 0
+   end function relaxes_to_eos
 
    !> The in-plane direction along which an inlet's `height` runs: t = (-d_y, d_x, 0), d the unit
    !> flow direction.

@@ -9,7 +9,7 @@
 !> depend on the number of ranks.
 module particle_seeding
    use kinds, only: rp, i8
-   use scene_description, only: scene_t, body_spec_t
+   use scene_description, only: scene_t, body_spec_t, relaxes_to_eos
    use tensor_layout, only: n_components
    use background_grid, only: grid_t
    use domain_decomposition, only: domain_t
@@ -68,7 +68,7 @@ contains
             particle_volume = product(spacing(1:dim))
             density = scene%materials(body%material_index)%density
             ! a fluid whose pressure relaxes toward its EOS starts in an EOS state (docs/volume-conservation.md)
-            eos_state = index(scene%materials(body%material_index)%volume_correction, 'eos_relaxation') > 0
+            eos_state = relaxes_to_eos(scene%materials(body%material_index))
             v_grid = 0.0_rp
             v_grid(1:dim) = grid%frame%grid_vector(body%velocity(1:dim))
             x_grid = 0.0_rp

@@ -13,7 +13,7 @@
 !> first_id + (inlet - 1) 2^40 + (k - 1) n_layer + index in the layer, independent of the rank count.
 module fluid_inflow
    use kinds, only: rp, i8
-   use scene_description, only: scene_t, inlet_spec_t, opening_tangent, opening_far_end
+   use scene_description, only: scene_t, inlet_spec_t, opening_tangent, opening_far_end, relaxes_to_eos
    use tensor_layout, only: n_components
    use background_grid, only: grid_t
    use domain_decomposition, only: domain_t
@@ -82,7 +82,7 @@ contains
                volume_across = spec%height * spec%width
             end if
             inlet%density = scene%materials(spec%material_index)%density
-            if (index(scene%materials(spec%material_index)%volume_correction, 'eos_relaxation') > 0) &
+            if (relaxes_to_eos(scene%materials(spec%material_index))) &
                inlet%eos_bulk_modulus = scene%materials(spec%material_index)%bulk_modulus
             ! a layer carries rho0 Dp H (W): the particle masses add up to exactly that
             inlet%particle_mass = inlet%density * inlet%spacing * volume_across / product(inlet%across)

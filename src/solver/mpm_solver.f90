@@ -341,7 +341,7 @@ contains
          call set_slice(m)
          call self%schemes(m)%scheme%filter_stress(context, self%particles)
       end do
-      if (self%volume%active()) then
+      if (self%volume%relaxing) then
          call self%timers%switch_to(phase_volume_correction)
          call self%volume%relax_pressure(self%particles)
       end if

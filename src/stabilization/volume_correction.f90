@@ -25,7 +25,7 @@
 !> the migration of the step see them. Costs nothing without a fluid that selects it.
 module volume_correction
    use kinds, only: rp, i8
-   use scene_description, only: scene_t
+   use scene_description, only: scene_t, shifts_particles, relaxes_to_eos
    use domain_decomposition, only: domain_t
    use background_grid, only: grid_t
    use grid_transfer, only: volume_to_grid, gradient_at_particles
@@ -55,6 +55,7 @@ module volume_correction
       real(rp), allocatable :: relaxation_rate(:)       !< per material: r, 0 without EOS relaxation
       real(rp), allocatable :: bulk_modulus(:), reference_density(:)
       logical :: shifting = .false.                 !< some material shifts
+      logical :: relaxing = .false.                 !< some material relaxes its pressure to the EOS
       integer :: interval = 1                       !< steps between two applications of the shifting
       logical :: shifting_now = .false.             !< this step applies it
       real(rp) :: gravity(3) = 0.0_rp               !< grid frame: the hydrostatic pressure change of a shift
@@ -64,7 +65,6 @@ module volume_correction
       real(rp), allocatable :: shift(:, :)          !< (dim, p): displacement added after the position update
    contains
       procedure :: init => corrector_init
-      procedure :: active => corrector_active
       procedure :: reset_grid => corrector_reset_grid
       procedure :: prepare => corrector_prepare
       procedure :: apply_shifts => corrector_apply_shifts
@@ -89,20 +89,15 @@ contains
             self%reference_density(m) = spec%density
             self%shifting_coefficient(m) = 0.0_rp
             self%relaxation_rate(m) = 0.0_rp
-            if (index(spec%volume_correction, 'shifting') > 0) self%shifting_coefficient(m) = spec%shifting_coefficient
-            if (index(spec%volume_correction, 'eos_relaxation') > 0) self%relaxation_rate(m) = spec%eos_relaxation_rate
+            if (shifts_particles(spec)) self%shifting_coefficient(m) = spec%shifting_coefficient
+            if (relaxes_to_eos(spec)) self%relaxation_rate(m) = spec%eos_relaxation_rate
          end associate
       end do
       self%shifting = any(self%shifting_coefficient > 0.0_rp)
+      self%relaxing = any(self%relaxation_rate > 0.0_rp)
       if (self%shifting) self%interval = max(1, floor(coefficient_per_application / maxval(self%shifting_coefficient) &
                                                        * (1.0_rp + 1.0e-12_rp)))
    end subroutine corrector_init
-
-   pure logical function corrector_active(self)
-      class(volume_corrector_t), intent(in) :: self
-      corrector_active = .false.
-      if (allocated(self%relaxation_rate)) corrector_active = self%shifting .or. any(self%relaxation_rate > 0.0_rp)
-   end function corrector_active
 
    !> The grid changed (layout): V_i is measured again at the next prepare.
    subroutine corrector_reset_grid(self)
