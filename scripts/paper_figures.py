@@ -393,6 +393,8 @@ def figure_volume(args):
             results[key][label] = {"h_eq": final[1], "h_cm": final[2], "h_top": final[3], "p_bottom_kPa": final[4] / 1e3,
                                    "h_cm_drift_percent": 100 * (final[2] / m[0, 2] - 1) if key == "tank45" else None,
                                    "h_top_drift_percent": 100 * (final[3] / m[0, 3] - 1) if key == "tank45" else None,
+                                   "h_cm_largest_drift_percent": 100 * np.abs(m[:, 2] / m[0, 2] - 1).max(),
+                                   "h_top_largest_drift_percent": 100 * np.abs(m[:, 3] / m[0, 3] - 1).max(),
                                    "end_time": final[0], "wall_seconds": run_cost(folder)}
         axes[0].set_ylabel("h_cm = 2 x mass centre height [m]")
         axes[1].set_ylabel("h_top = surface height [m]")
@@ -424,12 +426,13 @@ def figure_volume(args):
     assert_claim(args, best["end_time"] > 3.0 - 1e-9 and abs(best["h_cm_drift_percent"]) < 0.5 * abs(plain["h_cm_drift_percent"]),
                  "volume: the recommended correction at least halves FOAL1's h_cm loss in the 45 degree tank",
                  (round(best["h_cm_drift_percent"], 3), round(plain["h_cm_drift_percent"], 3)))
-    check(abs(best["h_cm_drift_percent"]) <= 0.5,
-          "volume: the recommended correction keeps h_cm of the 45 degree tank within 0.5 % over 3 s",
-          round(best["h_cm_drift_percent"], 3))
-    check(abs(best["h_top_drift_percent"]) <= 0.5,
-          "volume: the recommended correction keeps the surface of the 45 degree tank within 0.5 % over 3 s",
-          round(best["h_top_drift_percent"], 3))
+    # at every output of the 3 s, not only at the end
+    assert_claim(args, best["h_cm_largest_drift_percent"] <= 0.5,
+                 "volume: the recommended correction keeps h_cm of the 45 degree tank within 0.5 % over 3 s",
+                 (round(best["h_cm_drift_percent"], 3), round(best["h_cm_largest_drift_percent"], 3)))
+    assert_claim(args, best["h_top_largest_drift_percent"] <= 0.5,
+                 "volume: the recommended correction keeps the surface of the 45 degree tank within 0.5 % over 3 s",
+                 (round(best["h_top_drift_percent"], 3), round(best["h_top_largest_drift_percent"], 3)))
     assert_claim(args, abs(results["tank0_recommended"]["h_cm_drift_percent"]) <= 0.05,
                  "volume: the recommended correction keeps the aligned tank at rest (h_cm within 0.05 %)",
                  round(results["tank0_recommended"]["h_cm_drift_percent"], 4))
