@@ -30,7 +30,7 @@ program flotsam_bench
    use field_output, only: write_fields
    use checkpoint, only: write_checkpoint
    use health_check, only: particles_healthy
-   use simulation, only: blow_up_speed
+   use simulation, only: blow_up_speed, blow_up_densities
    use process_memory, only: resident_bytes, peak_resident_bytes
    use phase_timers, only: phase_names, phase_rebalance, phase_other
    implicit none
@@ -158,7 +158,7 @@ contains
       speed_limit = blow_up_speed(solver)
       t0 = MPI_Wtime()
       do k = 1, checks         ! as in the time loop: the local check and the agreement on 3 flags
-         healthy = particles_healthy(solver%particles, speed_limit)
+         healthy = particles_healthy(solver%particles, speed_limit, blow_up_densities(solver))
          flags = merge(0, 1, healthy)
          call MPI_Allreduce(MPI_IN_PLACE, flags, 3, MPI_INTEGER, MPI_MAX, MPI_COMM_WORLD)
       end do

@@ -2,7 +2,9 @@
 !> "When the solution blows up").
 !>
 !> A particle is unhealthy when a position, velocity, density or stress component is not finite, its
-!> density is not positive, or its speed exceeds the run's speed limit. The check that runs every step
+!> density is not positive or lies outside the run's density limits (a factor of 100 around the
+!> materials' reference densities: a J that ran away at sane speeds), or its speed exceeds the run's
+!> speed limit. The check that runs every step
 !> reads velocity, density and stress once, as flat arrays, in 8 independent partial sums (so the loops
 !> vectorise without reordering the additions): a sum is finite only if every value is (a NaN or an
 !> infinity propagates through a sum; the finite values of a sane state cannot overflow it). Positions
@@ -25,11 +27,13 @@ module health_check
 
 contains
 
-   !> True if every particle is healthy (see the module). `speed_limit` in m/s.
-   logical function particles_healthy(particles, speed_limit) result(healthy)
+   !> True if every particle is healthy (see the module). `speed_limit` in m/s; `density_limits` the
+   !> lowest and highest density allowed [kg/m^3] (without: any positive density).
+   logical function particles_healthy(particles, speed_limit, density_limits) result(healthy)
       type(particle_set_t), intent(in) :: particles
       real(rp), intent(in) :: speed_limit
-      real(rp) :: total, largest, smallest
+      real(rp), intent(in), optional :: density_limits(2)
+      real(rp) :: total, largest, smallest, densest
       integer :: n
       n = particles%count
       healthy = .true.
@@ -37,8 +41,9 @@ contains
       total = 0.0_rp
       largest = 0.0_rp
       smallest = huge(1.0_rp)
+      densest = 0.0_rp
       call scan_values(particles%v, particles%dim * n, total, largest=largest)
-      call scan_values(particles%density, n, total, smallest=smallest)
+      call scan_values(particles%density, n, total, largest=densest, smallest=smallest)
       call scan_values(particles%sbar, particles%n_sigma * n, total)
       if (.not. ieee_is_finite(total)) then
          healthy = .false.
@@ -46,6 +51,8 @@ contains
       end if
       ! every value is finite from here. |v| <= sqrt(dim) max_k |v_k|: look closer only near the limit
       healthy = smallest > 0.0_rp
+      if (present(density_limits)) healthy = healthy .and. smallest >= density_limits(1) .and. &
+                                             densest <= density_limits(2)
       if (healthy .and. sqrt(real(particles%dim, rp)) * largest > speed_limit) &
          healthy = maxval(sum(particles%v(:, 1:n)**2, dim=1)) <= speed_limit**2
    end function particles_healthy
@@ -65,7 +72,15 @@ contains
       high = 0.0_rp
       low = huge(1.0_rp)
       ! one loop per case, so that each array is read once
-      if (present(largest)) then
+      if (present(largest) .and. present(smallest)) then
+         do i = 1, tail, width
+            sums = sums + values(i:i + width - 1)
+            high = max(high, abs(values(i:i + width - 1)))
+            low = min(low, values(i:i + width - 1))
+         end do
+         largest = max(largest, maxval(high), maxval(abs(values(tail + 1:n)), mask=n > tail))
+         smallest = min(smallest, minval(low), minval(values(tail + 1:n), mask=n > tail))
+      else if (present(largest)) then
          do i = 1, tail, width
             sums = sums + values(i:i + width - 1)
             high = max(high, abs(values(i:i + width - 1)))
@@ -88,18 +103,23 @@ contains
    !> The first unhealthy particle (local index; 0 if none) and what is wrong with it, e.g.
    !> "particle 1234 (material 'water') at x = (0.5, 0.25): velocity y = NaN". The position is given in
    !> the world frame (through `frame`) when it is finite; the quantities in the grid's frame.
-   subroutine describe_unhealthy_particle(particles, frame, speed_limit, material_names, particle, description)
+   subroutine describe_unhealthy_particle(particles, frame, speed_limit, material_names, particle, description, &
+                                          density_limits)
       type(particle_set_t), intent(in) :: particles
       type(frame_t), intent(in) :: frame
       real(rp), intent(in) :: speed_limit
       character(len=*), intent(in) :: material_names(:)
       integer, intent(out) :: particle
       character(len=:), allocatable, intent(out) :: description
+      real(rp), intent(in), optional :: density_limits(2)
       character(len=:), allocatable :: problem, where
+      real(rp) :: limits(2)
       integer :: p
       description = ''
+      limits = [0.0_rp, huge(1.0_rp)]
+      if (present(density_limits)) limits = density_limits
       do p = 1, particles%count
-         call find_problem(particles, p, speed_limit, problem)
+         call find_problem(particles, p, speed_limit, limits, problem)
          if (len(problem) == 0) cycle
          particle = p
          if (all(ieee_is_finite(particles%x(:, p)))) then
@@ -115,11 +135,11 @@ contains
    end subroutine describe_unhealthy_particle
 
    !> What is wrong with particle p ('' if nothing): the first non-finite quantity (velocity, density,
-   !> stress, position), else a non-positive density, else a speed above the limit.
-   subroutine find_problem(particles, p, speed_limit, problem)
+   !> stress, position), else a non-positive density, else one outside the limits, else a speed above the limit.
+   subroutine find_problem(particles, p, speed_limit, density_limits, problem)
       type(particle_set_t), intent(in) :: particles
       integer, intent(in) :: p
-      real(rp), intent(in) :: speed_limit
+      real(rp), intent(in) :: speed_limit, density_limits(2)
       character(len=:), allocatable, intent(out) :: problem
       integer :: k
       real(rp) :: speed
@@ -145,6 +165,12 @@ contains
       end do
       if (.not. particles%density(p) > 0.0_rp) then
          problem = 'density = '//real_text(particles%density(p))//' kg/m^3 (must be > 0)'
+         return
+      end if
+      if (particles%density(p) < density_limits(1) .or. particles%density(p) > density_limits(2)) then
+         problem = 'density = '//real_text(particles%density(p))//' kg/m^3, outside ['// &
+                   real_text(density_limits(1))//', '//real_text(density_limits(2))//'] (100 times the '// &
+                   'materials'' reference densities either way)'
          return
       end if
       speed = norm2(particles%v(:, p))

@@ -33,10 +33,11 @@ module simulation
    implicit none
    private
 
-   public :: run_simulation, blow_up_speed
+   public :: run_simulation, blow_up_speed, blow_up_densities
 
    !> The default speed limit is this multiple of the fastest wave speed of the materials.
    real(rp), parameter :: speed_limit_factor = 10.0_rp
+   real(rp), parameter :: density_limit_factor = 100.0_rp
 
    !> Positions of the flags agreed on after every step.
    integer, parameter :: flag_unhealthy = 1, flag_signal = 2, flag_wall_checkpoint = 3
@@ -56,7 +57,7 @@ contains
       type(progress_reporter_t) :: reporter
       type(diagnostics_t) :: diag
       character(len=:), allocatable :: dir, checkpoint_path
-      real(rp) :: end_time, interval, speed_limit, last_checkpoint_wall
+      real(rp) :: end_time, interval, speed_limit, last_checkpoint_wall, density_limits(2)
       integer :: flags(3)
       integer(i8) :: last_checkpoint_step, first_step, particle_steps
       logical :: at_output, checkpoint_due
@@ -67,6 +68,7 @@ contains
       end_time = solver%run%end_time
       interval = solver%run%output_interval
       speed_limit = blow_up_speed(solver)
+      density_limits = blow_up_densities(solver)
       call open_diagnostics(solver, progress, csv, status)
       if (.not. status%ok) return
 
@@ -109,7 +111,7 @@ contains
 
          call solver%timers%switch_to(phase_health)
          flags = 0
-         if (.not. particles_healthy(solver%particles, speed_limit)) flags(flag_unhealthy) = 1
+         if (.not. particles_healthy(solver%particles, speed_limit, density_limits)) flags(flag_unhealthy) = 1
          flags(flag_signal) = received_termination_signal()
          if (solver%domain%rank == 0 .and. solver%run%checkpoint_interval_wall > 0.0_rp) then
             if (reporter%elapsed() - last_checkpoint_wall >= solver%run%checkpoint_interval_wall) &
@@ -119,7 +121,7 @@ contains
          call solver%timers%switch_to(phase_other)
 
          if (flags(flag_unhealthy) > 0) then
-            call report_blow_up(solver, progress, speed_limit, status)
+            call report_blow_up(solver, progress, speed_limit, density_limits, status)
             outcome = 'blew_up'
             exit
          end if
@@ -196,6 +198,21 @@ contains
       end do
    end function blow_up_speed
 
+   !> The densities taken as a blow-up [kg/m^3]: below the lightest material's reference density or above
+   !> the heaviest's by density_limit_factor. No flow of a weakly compressible fluid or an elastic solid
+   !> comes near it; a particle's J that runs away under a smoothed pressure (the stress is the cell's, the
+   !> J the particle's own) passes it at sane speeds, which the speed limit cannot see. [R]
+   function blow_up_densities(solver) result(limits)
+      type(solver_t), intent(in) :: solver
+      real(rp) :: limits(2)
+      integer :: m
+      limits = [huge(1.0_rp), 0.0_rp]
+      do m = 1, size(solver%materials)
+         limits(1) = min(limits(1), solver%materials(m)%model%reference_density / density_limit_factor)
+         limits(2) = max(limits(2), solver%materials(m)%model%reference_density * density_limit_factor)
+      end do
+   end function blow_up_densities
+
    !> Rank 0 opens diagnostics.csv: new with its header, or for a restart cut back to the rows up to the
    !> checkpoint's step and continued. Collective (the status is broadcast).
    subroutine open_diagnostics(solver, progress, csv, status)
@@ -251,10 +268,10 @@ contains
 
    !> Some rank holds an unhealthy particle: name the lowest such rank's first one, write the state as
    !> a last output for inspection, and fail. Collective.
-   subroutine report_blow_up(solver, progress, speed_limit, status)
+   subroutine report_blow_up(solver, progress, speed_limit, density_limits, status)
       type(solver_t), intent(inout) :: solver
       type(run_progress_t), intent(inout) :: progress
-      real(rp), intent(in) :: speed_limit
+      real(rp), intent(in) :: speed_limit, density_limits(2)
       type(status_t), intent(inout) :: status
       type(status_t) :: output_status
       character(len=:), allocatable :: description, inspection
@@ -263,7 +280,8 @@ contains
       do m = 1, size(solver%materials)
          names(m) = solver%materials(m)%model%name
       end do
-      call describe_unhealthy_particle(solver%particles, solver%grid%frame, speed_limit, names, particle, description)
+      call describe_unhealthy_particle(solver%particles, solver%grid%frame, speed_limit, names, particle, description, &
+                                       density_limits)
       if (particle > 0) call status%fail('the solution blew up at step '//int_text(solver%step)//' (t = '// &
                                          real_text(solver%time)//' s) on rank '//int_text(solver%domain%rank)//': '// &
                                          description)

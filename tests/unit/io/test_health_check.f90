@@ -1,6 +1,6 @@
 !> Tests of src/solver/health_check.f90: a sane state passes; a NaN or infinity in any quantity, a
-!> non-positive density or a speed above the limit fails, and the report names the particle (its
-!> global id, material and position) and the quantity.
+!> non-positive density, a density outside the run's limits or a speed above the limit fails, and the
+!> report names the particle (its global id, material and position) and the quantity.
 module test_health_check
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_positive_inf
    use kinds, only: rp, i8
@@ -12,7 +12,7 @@ module test_health_check
    private
 
    public :: test_sane_state_is_healthy, test_nan_stress_is_named, test_infinite_position_is_named, &
-             test_negative_density_is_named, test_speed_above_limit_is_named
+             test_negative_density_is_named, test_speed_above_limit_is_named, test_runaway_density_is_named
 
    real(rp), parameter :: limit = 100.0_rp
    character(len=8), parameter :: names(2) = ['water   ', 'block   ']
@@ -92,4 +92,30 @@ contains
       call check_report(particles, 50, "particle 1050 (material 'block') at x = (0.5, 0.5): speed = 100.08")
       call check_report(particles, 50, 'm/s exceeds &run speed_limit = 100.0 m/s')
    end subroutine test_speed_above_limit_is_named
+
+   !> A J that ran away at sane speeds: 100 times the reference density passes, more fails, either way;
+   !> without limits any positive density passes.
+   subroutine test_runaway_density_is_named()
+      type(particle_set_t) :: particles
+      real(rp), parameter :: limits(2) = [10.0_rp, 1.0e5_rp]
+      integer :: particle
+      character(len=:), allocatable :: description
+      type(frame_t) :: frame
+      particles = sane_particles()
+      particles%density(50) = 1.0e5_rp
+      particles%density(3) = 10.0_rp
+      call assertTrue(particles_healthy(particles, limit, limits), 'at the limits: still healthy')
+      particles%density(50) = 1.01e5_rp
+      call assertTrue(particles_healthy(particles, limit), 'no limits: any positive density')
+      call assertFalse(particles_healthy(particles, limit, limits), 'above the limit: detected')
+      call describe_unhealthy_particle(particles, frame, limit, names, particle, description, limits)
+      call assertEqual(50, particle, 'the dense particle')
+      call assertTrue(index(description, 'density = 101000.0 kg/m^3, outside [10.0, 100000.0]') > 0, &
+                      'report "'//description//'"')
+      particles%density(50) = 1000.0_rp
+      particles%density(17) = 9.9_rp
+      call assertFalse(particles_healthy(particles, limit, limits), 'below the limit: detected')
+      call describe_unhealthy_particle(particles, frame, limit, names, particle, description, limits)
+      call assertEqual(17, particle, 'the light particle')
+   end subroutine test_runaway_density_is_named
 end module test_health_check
