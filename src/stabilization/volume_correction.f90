@@ -285,7 +285,8 @@ contains
       type(volume_corrector_t), intent(inout) :: self
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
-      integer :: m, p, cell
+      integer :: m, p
+      integer, allocatable :: cell(:)
       if (.not. allocated(self%cell_mass)) allocate (self%cell_mass(grid%cell_count), self%cell_volume(grid%cell_count))
       if (size(self%cell_mass) /= grid%cell_count) then
          deallocate (self%cell_mass, self%cell_volume)
@@ -295,17 +296,17 @@ contains
          if (self%shifting_coefficient(m) <= 0.0_rp) cycle
          self%cell_mass = 0.0_rp
          self%cell_volume = 0.0_rp
+         allocate (cell(particles%material_first(m):max(particles%material_first(m), particles%material_last(m))))
          do p = particles%material_first(m), particles%material_last(m)
-            cell = grid%owned_local_cell(particles%x(:, p))
-            if (cell == 0) cycle
-            self%cell_mass(cell) = self%cell_mass(cell) + particles%mass(p)
-            self%cell_volume(cell) = self%cell_volume(cell) + particles%mass(p) / particles%density(p)
+            cell(p) = grid%owned_local_cell(particles%x(:, p))
+            if (cell(p) == 0) cycle
+            self%cell_mass(cell(p)) = self%cell_mass(cell(p)) + particles%mass(p)
+            self%cell_volume(cell(p)) = self%cell_volume(cell(p)) + particles%mass(p) / particles%density(p)
          end do
          do p = particles%material_first(m), particles%material_last(m)
-            cell = grid%owned_local_cell(particles%x(:, p))
-            if (cell == 0) cycle
-            particles%density(p) = self%cell_mass(cell) / self%cell_volume(cell)
+            if (cell(p) > 0) particles%density(p) = self%cell_mass(cell(p)) / self%cell_volume(cell(p))
          end do
+         deallocate (cell)
       end do
    end subroutine equalize_cell_volumes
 
@@ -416,11 +417,7 @@ contains
                if (lowest >= dot_product(x_node(1:dim), self%up(1:dim)) + rise) cycle   ! wholly below
                ! a node above the surface is in the air: psi = 0 there, so the crowding of the layer under
                ! the surface drains through it (a zero excess on the surface itself, where a node rarely is)
-               do k = 1, dim - 1
-                  u = dot_product(x_node(1:dim), self%horizontal(1:dim, k)) - self%bin_lo(k)
-                  first(k) = min(nb(k), max(1, 1 + floor(u / self%bin_width)))
-               end do
-               if (self%surface_height(first(1), first(2)) < dot_product(x_node(1:dim), self%up(1:dim))) then
+               if (surface_over(self, x_node, dim) < dot_product(x_node(1:dim), self%up(1:dim))) then
                   self%fluid_volume(node) = 0.0_rp
                   cycle
                end if
@@ -432,11 +429,7 @@ contains
                      x(k) = x_node(k) + grid%h * (-1.0_rp + (real(s(k), rp) - 0.5_rp) / surface_samples_per_cell(dim))
                      weight = weight * (1.0_rp - abs(x(k) - x_node(k)) * grid%inv_h)
                   end do
-                  do k = 1, dim - 1
-                     u = dot_product(x(1:dim), self%horizontal(1:dim, k)) - self%bin_lo(k)
-                     first(k) = min(nb(k), max(1, 1 + floor(u / self%bin_width)))
-                  end do
-                  surface = self%surface_height(first(1), first(2)) - dot_product(x(1:dim), self%up(1:dim))
+                  surface = surface_over(self, x, dim) - dot_product(x(1:dim), self%up(1:dim))
                   if (surface > -half_depth) then     ! not wholly above the surface (no_surface is)
                      share = 1.0_rp
                      if (surface < half_depth) call part_below(surface, extent(1:dim), share, rise_of_part)
@@ -460,6 +453,20 @@ contains
          end do
       end do
    end subroutine cut_by_surface
+
+   !> The height function over point x: its bin's height (no_surface where no particle is).
+   pure real(rp) function surface_over(self, x, dim) result(height)
+      type(volume_corrector_t), intent(in) :: self
+      real(rp), intent(in) :: x(3)
+      integer, intent(in) :: dim
+      integer :: bin(2), k
+      bin = 1
+      do k = 1, dim - 1
+         bin(k) = min(size(self%surface_height, k), max(1, 1 + floor((dot_product(x(1:dim), &
+                  self%horizontal(1:dim, k)) - self%bin_lo(k)) / self%bin_width)))
+      end do
+      height = self%surface_height(bin(1), bin(2))
+   end function surface_over
 
    !> `fraction` of a box with depths m(k) = a_k |up_k| along up (edges a_k on the grid axes) that lies
    !> below the plane `distance` above its centre, exactly: the volume of a box cut by a plane
