@@ -41,6 +41,7 @@ module volume_correction
    use node_halo, only: sum_shared_nodes
    use particle_set, only: particle_set_t
    use boundary_walls, only: wall_t, wall_kind_prescribed, behind_wall
+   use cell_binning, only: cell_list_t, start_cell_list, bin_cell_mass, replace_by_cell_average
    use newtonian_fluid, only: eos_pressure
    implicit none
    private
@@ -84,7 +85,9 @@ module volume_correction
       real(rp), allocatable :: open_volume(:)       !< V_i per local node [m^dim], walls only
       logical, allocatable :: fully_open(:)         !< no wall nor the grid's edge cuts the node's support
       real(rp), allocatable :: fluid_volume(:)      !< V_i cut by the free surface [m^dim]
-      real(rp), allocatable :: cell_mass(:), cell_volume(:)   !< per owned cell: one material's particles
+      type(cell_list_t) :: occupied                 !< the cells holding one shifting material's particles
+      real(rp), allocatable :: cell_mass(:)         !< per cell: that material's mass
+      real(rp), allocatable :: cell_average(:, :)   !< per cell: its mean specific volume (work)
       logical :: surface_model = .false.            !< under gravity: V_i knows where the free surface is
       real(rp) :: up(3) = 0.0_rp                    !< against gravity, unit (grid frame)
       real(rp) :: horizontal(3, 2) = 0.0_rp         !< unit vectors normal to up (dim - 1 of them)
@@ -277,36 +280,34 @@ contains
                                self%up(1) * self%horizontal(2, 1) - self%up(2) * self%horizontal(1, 1)]
    end subroutine horizontal_frame
 
-   !> Within each owned cell, the particles of each shifting material share one density, m_c / V_c (mass
-   !> and volume of the cell's particles of that material kept): C0's cell-based view applied to the volume.
-   !> A particle's own J otherwise carries the history of the cells it crossed, and nothing in C0 or FOAL1
-   !> pulls it back (the pressure is the cell's), so it can drift without bound.
+   !> Within each cell, the particles of each shifting material share one density, m_c / V_c (mass and
+   !> volume of the cell's particles of that material kept): C0's cell average ([Y17] eq. 4, through
+   !> cell_binning, by particles%cell at x^n) applied to the specific volume 1/rho, whose mass-weighted
+   !> mean is V_c / m_c. A particle's own J otherwise carries the history of the cells it crossed, and
+   !> nothing in C0 or FOAL1 pulls it back (the pressure is the cell's), so it can drift without bound.
    subroutine equalize_cell_volumes(self, grid, particles)
       type(volume_corrector_t), intent(inout) :: self
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
-      integer :: m, p
-      integer, allocatable :: cell(:)
-      if (.not. allocated(self%cell_mass)) allocate (self%cell_mass(grid%cell_count), self%cell_volume(grid%cell_count))
-      if (size(self%cell_mass) /= grid%cell_count) then
-         deallocate (self%cell_mass, self%cell_volume)
-         allocate (self%cell_mass(grid%cell_count), self%cell_volume(grid%cell_count))
+      real(rp), allocatable :: specific_volume(:, :)
+      integer :: m, first, last
+      if (allocated(self%cell_mass)) then
+         if (size(self%cell_mass) /= grid%cell_count) deallocate (self%cell_mass, self%cell_average)
+      end if
+      if (.not. allocated(self%cell_mass)) then
+         allocate (self%cell_mass(grid%cell_count), self%cell_average(1, grid%cell_count))
+         call start_cell_list(grid%cell_count, self%occupied, self%cell_mass)
       end if
       do m = 1, size(self%shifting_coefficient)
          if (self%shifting_coefficient(m) <= 0.0_rp) cycle
-         self%cell_mass = 0.0_rp
-         self%cell_volume = 0.0_rp
-         allocate (cell(particles%material_first(m):max(particles%material_first(m), particles%material_last(m))))
-         do p = particles%material_first(m), particles%material_last(m)
-            cell(p) = grid%owned_local_cell(particles%x(:, p))
-            if (cell(p) == 0) cycle
-            self%cell_mass(cell(p)) = self%cell_mass(cell(p)) + particles%mass(p)
-            self%cell_volume(cell(p)) = self%cell_volume(cell(p)) + particles%mass(p) / particles%density(p)
-         end do
-         do p = particles%material_first(m), particles%material_last(m)
-            if (cell(p) > 0) particles%density(p) = self%cell_mass(cell(p)) / self%cell_volume(cell(p))
-         end do
-         deallocate (cell)
+         first = particles%material_first(m)
+         last = particles%material_last(m)
+         if (last < first) cycle
+         call bin_cell_mass(particles, first, last, self%occupied, self%cell_mass)
+         specific_volume = reshape(1.0_rp / particles%density(first:last), [1, last - first + 1])
+         call replace_by_cell_average(particles, first, last, self%occupied, self%cell_mass, specific_volume, &
+                                      self%cell_average)
+         particles%density(first:last) = 1.0_rp / specific_volume(1, :)
       end do
    end subroutine equalize_cell_volumes
 
@@ -478,7 +479,8 @@ contains
    pure subroutine part_below(distance, m, fraction, centroid)
       real(rp), intent(in) :: distance, m(:)
       real(rp), intent(out) :: fraction, centroid
-      real(rp) :: depth(3), alpha, total, volume, moment, corner
+      real(rp), parameter :: factorial(3) = [1.0_rp, 2.0_rp, 6.0_rp]
+      real(rp) :: depth(3), alpha, total, volume, moment, corner, sign
       integer :: n, k, subset
       n = 0
       do k = 1, size(m)
@@ -506,11 +508,12 @@ contains
             if (btest(subset, k - 1)) corner = corner - depth(k)
          end do
          if (corner <= 0.0_rp) cycle
-         volume = volume + merge(-1.0_rp, 1.0_rp, mod(popcnt(subset), 2) == 1) * corner**n
-         moment = moment + merge(-1.0_rp, 1.0_rp, mod(popcnt(subset), 2) == 1) * corner**(n + 1)
+         sign = merge(-1.0_rp, 1.0_rp, mod(popcnt(subset), 2) == 1)     ! (-1)^|S|
+         volume = volume + sign * corner**n
+         moment = moment + sign * corner**(n + 1)
       end do
       ! volume / (n! prod m) is F; moment / ((n+1)! prod m) its integral
-      fraction = min(1.0_rp, max(0.0_rp, volume / (product(depth(1:n)) * gamma(real(n + 1, rp)))))
+      fraction = min(1.0_rp, max(0.0_rp, volume / (product(depth(1:n)) * factorial(n))))
       if (volume > 0.0_rp) centroid = alpha - moment / ((n + 1) * volume) - 0.5_rp * total
    end subroutine part_below
 
