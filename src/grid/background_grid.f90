@@ -27,6 +27,8 @@ module background_grid
       integer :: cell_lo(3) = 0, cell_hi(3) = 0    !< owned cells (global, 0-based)
       integer :: n_cells(3) = 1, cell_count = 0
       integer :: corner_stride(8) = 0              !< local node offset of corner a from the cell's lower node
+      !> along axis k the rank's cells end where the active region does: it owns its upper node layer too
+      logical :: owns_upper(3) = .true.
       integer :: row_momentum = 2, row_force = 4, n_rows = 5
       real(rp), allocatable :: accumulated(:, :)   !< (n_rows, node): mass, momentum, force
       real(rp), allocatable :: velocity(:, :)      !< v_i^{n+theta} used for kinematics and positions
@@ -34,6 +36,8 @@ module background_grid
    contains
       procedure :: init => grid_init
       procedure :: local_node => grid_local_node
+      procedure :: node_indices => grid_node_indices
+      procedure :: owns_node => grid_owns_node
       procedure :: local_cell => grid_local_cell
       procedure :: base_node_of_cell => grid_base_node_of_cell
       procedure :: cell_of_position => grid_cell_of_position
@@ -59,6 +63,12 @@ contains
       self%global_cells = domain%global_cells
       self%cell_lo = domain%cell_lo
       self%cell_hi = domain%cell_hi
+      self%owns_upper = .true.
+      if (allocated(domain%cuts)) then
+         do k = 1, self%dim
+            self%owns_upper(k) = domain%cell_hi(k) == domain%cuts(domain%dims(k), k) - 1
+         end do
+      end if
       self%n_cells = 1
       self%n_cells(1:self%dim) = self%cell_hi(1:self%dim) - self%cell_lo(1:self%dim) + 1
       self%cell_count = product(self%n_cells)
@@ -99,6 +109,30 @@ contains
       end do
       grid_local_node = grid_local_node + 1
    end function grid_local_node
+
+   !> Global indices (0-based) of the local node with flat index `node` (the inverse of local_node).
+   pure function grid_node_indices(self, node) result(g)
+      class(grid_t), intent(in) :: self
+      integer, intent(in) :: node
+      integer :: g(self%dim), k, rest
+      rest = node - 1
+      do k = 1, self%dim
+         g(k) = self%node_lo(k) + mod(rest, self%n_nodes(k))
+         rest = rest / self%n_nodes(k)
+      end do
+   end function grid_node_indices
+
+   !> True if this rank is the one that counts the local node g (global indices) in sums over nodes: a
+   !> node shared with the rank above along an axis belongs to that rank (the lower corner of its cells).
+   pure logical function grid_owns_node(self, g) result(owns)
+      class(grid_t), intent(in) :: self
+      integer, intent(in) :: g(:)
+      integer :: k
+      owns = .true.
+      do k = 1, self%dim
+         if (g(k) > self%cell_hi(k) .and. .not. self%owns_upper(k)) owns = .false.
+      end do
+   end function grid_owns_node
 
    !> Local flat index of the owned cell with global indices c (0-based).
    pure integer function grid_local_cell(self, c)

@@ -21,7 +21,7 @@ contains
       type(MPI_Comm), intent(in) :: comm
       integer, intent(in) :: root
       character(len=1), allocatable :: bytes(:)
-      integer :: counts(4), rank_count(4), rank, n, at
+      integer :: counts(5), rank_count(5), rank, n, at
 
       ! -1 stands for "not allocated".
       counts = -1
@@ -29,6 +29,7 @@ contains
       if (allocated(scene%bodies)) counts(2) = size(scene%bodies)
       if (allocated(scene%walls)) counts(3) = size(scene%walls)
       if (allocated(scene%inlets)) counts(4) = size(scene%inlets)
+      if (allocated(scene%gauges)) counts(5) = size(scene%gauges)
       rank_count = counts
       call MPI_Bcast(counts, size(counts), MPI_INTEGER, root, comm)
       if (any(counts /= rank_count)) then
@@ -36,10 +37,12 @@ contains
          if (allocated(scene%bodies)) deallocate (scene%bodies)
          if (allocated(scene%walls)) deallocate (scene%walls)
          if (allocated(scene%inlets)) deallocate (scene%inlets)
+         if (allocated(scene%gauges)) deallocate (scene%gauges)
          if (counts(1) >= 0) allocate (scene%materials(counts(1)))
          if (counts(2) >= 0) allocate (scene%bodies(counts(2)))
          if (counts(3) >= 0) allocate (scene%walls(counts(3)))
          if (counts(4) >= 0) allocate (scene%inlets(counts(4)))
+         if (counts(5) >= 0) allocate (scene%gauges(counts(5)))
       end if
 
       ! the parts one after the other, packed on root and unpacked in the same order elsewhere
@@ -52,6 +55,7 @@ contains
          if (counts(2) > 0) bytes = [bytes, transfer(scene%bodies, byte_mold)]
          if (counts(3) > 0) bytes = [bytes, transfer(scene%walls, byte_mold)]
          if (counts(4) > 0) bytes = [bytes, transfer(scene%inlets, byte_mold)]
+         if (counts(5) > 0) bytes = [bytes, transfer(scene%gauges, byte_mold)]
          n = size(bytes)
       end if
       call MPI_Bcast(n, 1, MPI_INTEGER, root, comm)
@@ -72,6 +76,8 @@ contains
                                                    scene%walls, counts(3))
       if (counts(4) > 0) scene%inlets(:) = transfer(next_bytes(counts(4) * size(transfer(scene%inlets(1), byte_mold))), &
                                                     scene%inlets, counts(4))
+      if (counts(5) > 0) scene%gauges(:) = transfer(next_bytes(counts(5) * size(transfer(scene%gauges(1), byte_mold))), &
+                                                    scene%gauges, counts(5))
 
    contains
 

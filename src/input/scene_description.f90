@@ -37,6 +37,9 @@ module scene_description
       !> rebalance when the largest rank holds more than this multiple of the mean particles per rank; 0: never
       real(rp) :: rebalance_threshold = 1.1_rp
       integer :: rebalance_interval = 20      !< steps between balance checks (also at every output time)
+      !> simulated time between rows of loads.csv, gauges.csv and bodies.csv [s]; 0: every step. Loads are
+      !> averages over the interval (impulse / length), gauges and body states samples at the row's time.
+      real(rp) :: load_interval = 1.0e-3_rp
    end type run_control_t
 
    !> `&grid` and `&box_walls`: the scene box (world frame), the grid that covers it, and the box's walls.
@@ -51,6 +54,9 @@ module scene_description
       integer :: ncells(3) = 1                !< derived: extent / cell_size (1 on unused axes)
       !> wall condition per side: (1, k) lower side, (2, k) upper side of axis k
       character(len=name_len) :: wall(2, 3) = wall_none
+      !> name of each side's wall in loads.csv (`&box_walls x_min_name` ...); resolved default 'x_min' ...
+      !> for a side that is a wall, '' for an open side
+      character(len=name_len) :: wall_name(2, 3) = ''
    end type grid_spec_t
 
    !> `&wall`: a plane wall (a segment in 2-D, a planar patch in 3-D), world frame. The wall is the part
@@ -62,12 +68,17 @@ module scene_description
       real(rp) :: lower(3) = -huge(1.0_rp)    !< extent of the wall: lower corner of its bounding box [m]
       real(rp) :: upper(3) = huge(1.0_rp)     !< upper corner [m]
       character(len=name_len) :: condition = wall_slip
+      character(len=name_len) :: name = ''    !< name in loads.csv; resolved default 'wall_<k>'
+      !> point the moment of the wall's load is taken about [m]; huge: not given, resolved to the component
+      !> of `point`
+      real(rp) :: moment_point(3) = huge(1.0_rp)
    end type wall_spec_t
 
    !> `&inlet`: an opening through which fluid enters at a constant speed (algorithms.md section 4.3).
    !> The opening lies in the plane through `point` normal to `direction` (the flow direction, world
    !> frame); it spans `height` along t = (-d_y, d_x, 0) from `point` and, in 3-D, `width` along z.
    type, public :: inlet_spec_t
+      character(len=name_len) :: name = ''    !< name in loads.csv; resolved default 'inlet_<k>'
       character(len=name_len) :: material = ''
       integer :: material_index = 0           !< derived: position in scene%materials
       real(rp) :: point(3) = 0.0_rp           !< lower end of the opening [m]
@@ -107,6 +118,7 @@ module scene_description
 
    !> `&body`: a rectangle (2-D) or box (3-D) of one material filled with particles.
    type, public :: body_spec_t
+      character(len=name_len) :: name = ''    !< name in bodies.csv; resolved default 'body_<k>'
       character(len=name_len) :: material = ''
       integer :: material_index = 0           !< derived: position in scene%materials
       real(rp) :: lower(3) = 0.0_rp           !< lower corner [m]
@@ -116,6 +128,21 @@ module scene_description
       logical :: hydrostatic = .false.        !< start from the hydrostatic stress of a fluid at rest
       real(rp) :: free_surface_level = 0.0_rp !< height of the free surface along -gravity [m]
    end type body_spec_t
+
+   !> Gauge kinds (`&gauge kind=`).
+   character(len=*), parameter, public :: gauge_pressure = 'pressure'
+   character(len=*), parameter, public :: gauge_level = 'level'
+   character(len=*), parameter, public :: gauge_velocity = 'velocity'
+
+   !> `&gauge`: a sensor of the fluid at a point, written to gauges.csv (docs/loads.md).
+   type, public :: gauge_spec_t
+      character(len=name_len) :: name = ''    !< column prefix in gauges.csv (required)
+      character(len=name_len) :: kind = ''    !< 'pressure', 'level' or 'velocity' (required)
+      real(rp) :: point(3) = 0.0_rp           !< where it measures, world frame [m] (required)
+      !> pressure, velocity: radius of the sphere (disc in 2-D) it averages over; level: half-width of the
+      !> column it looks in [m]; 0: resolved to the cell size (pressure, velocity) or half of it (level)
+      real(rp) :: radius = 0.0_rp
+   end type gauge_spec_t
 
    !> A whole scene.
    type, public :: scene_t
@@ -127,6 +154,7 @@ module scene_description
       type(body_spec_t), allocatable :: bodies(:)
       type(wall_spec_t), allocatable :: walls(:)      !< `&wall` groups (the `&box_walls` sides are in grid)
       type(inlet_spec_t), allocatable :: inlets(:)
+      type(gauge_spec_t), allocatable :: gauges(:)
    end type scene_t
 
 contains

@@ -11,9 +11,10 @@ module scene_reader
    use kinds, only: rp, i8, path_len
    use error_status, only: status_t
    use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
-                                inlet_spec_t, model_newtonian_fluid, model_linear_elastic
+                                inlet_spec_t, gauge_spec_t, model_newtonian_fluid, model_linear_elastic
    use namelist_scan, only: namelist_file_t, namelist_group_t, scan_namelist_file
-   use scene_validation, only: validate_scene, resolve_scene, stabilization_keywords, oscillation_rule_keywords
+   use scene_validation, only: validate_scene, resolve_scene, default_name, stabilization_keywords, &
+                               oscillation_rule_keywords
    use scene_broadcast, only: broadcast_scene
    use status_broadcast, only: broadcast_status
    use input_text, only: lower_case, upper_case, int_text, ordinal, group_context, canonical_keyword
@@ -25,8 +26,9 @@ module scene_reader
    !> A layer applied on top of the scene file: another namelist file, or namelist text from the command
    !> line (`--set '&grid rotation = 45 /'`). Singleton groups change the variables they assign; a
    !> repeated group changes the entries it selects: `&material name = 'water' ... /` the material named
-   !> water, `&body material = 'water' ... /` (and &inlet) the bodies of water; without the selecting
-   !> variable, every entry of the group. An override changes entries; it does not add them.
+   !> water, `&body material = 'water' ... /` (and &inlet) the bodies of water, `&wall name = 'left' ... /`
+   !> (and &gauge) the wall so named (an unnamed wall by its default name `wall_<k>`); without the
+   !> selecting variable, every entry of the group. An override changes entries; it does not add them.
    type, public :: scene_override_t
       character(len=:), allocatable :: source    !< file path, or namelist text
       logical :: is_text = .false.
@@ -36,11 +38,12 @@ module scene_reader
    integer, parameter :: root = 0
 
    character(len=*), parameter :: known_groups(*) = &
-      [character(len=9) :: 'run', 'grid', 'box_walls', 'gravity', 'material', 'body', 'wall', 'inlet']
+      [character(len=9) :: 'run', 'grid', 'box_walls', 'gravity', 'material', 'body', 'wall', 'inlet', 'gauge']
    !> Groups that may appear at most once.
    character(len=*), parameter :: singleton_groups(*) = [character(len=9) :: 'run', 'grid', 'box_walls', 'gravity']
    !> Groups that may appear any number of times, one scene entry each.
-   character(len=*), parameter :: repeated_groups(*) = [character(len=8) :: 'material', 'body', 'wall', 'inlet']
+   character(len=*), parameter :: repeated_groups(*) = &
+      [character(len=8) :: 'material', 'body', 'wall', 'inlet', 'gauge']
    !> Groups a scene file must contain.
    character(len=*), parameter :: required_groups(*) = [character(len=8) :: 'run', 'grid', 'material']
 
@@ -73,6 +76,7 @@ module scene_reader
       variable_info_t('run', 'speed_limit', 'real', .false.), &
       variable_info_t('run', 'rebalance_threshold', 'real', .false.), &
       variable_info_t('run', 'rebalance_interval', 'integer', .false.), &
+      variable_info_t('run', 'load_interval', 'real', .false.), &
       variable_info_t('grid', 'dim', 'integer', .false.), &
       variable_info_t('grid', 'cell_size', 'real', .true.), &
       variable_info_t('grid', 'origin', 'real3', .false.), &
@@ -84,6 +88,12 @@ module scene_reader
       variable_info_t('box_walls', 'y_max', 'string', .false.), &
       variable_info_t('box_walls', 'z_min', 'string', .false.), &
       variable_info_t('box_walls', 'z_max', 'string', .false.), &
+      variable_info_t('box_walls', 'x_min_name', 'string', .false.), &
+      variable_info_t('box_walls', 'x_max_name', 'string', .false.), &
+      variable_info_t('box_walls', 'y_min_name', 'string', .false.), &
+      variable_info_t('box_walls', 'y_max_name', 'string', .false.), &
+      variable_info_t('box_walls', 'z_min_name', 'string', .false.), &
+      variable_info_t('box_walls', 'z_max_name', 'string', .false.), &
       variable_info_t('gravity', 'acceleration', 'real3', .false.), &
       variable_info_t('material', 'name', 'string', .true.), &
       variable_info_t('material', 'model', 'string', .true.), &
@@ -101,6 +111,7 @@ module scene_reader
       variable_info_t('material', 'volume_correction', 'string', .false.), &
       variable_info_t('material', 'shifting_coefficient', 'real', .false.), &
       variable_info_t('material', 'eos_relaxation_rate', 'real', .false.), &
+      variable_info_t('body', 'name', 'string', .false.), &
       variable_info_t('body', 'material', 'string', .true.), &
       variable_info_t('body', 'lower', 'real3', .true.), &
       variable_info_t('body', 'upper', 'real3', .true.), &
@@ -113,6 +124,9 @@ module scene_reader
       variable_info_t('wall', 'lower', 'real3', .false.), &
       variable_info_t('wall', 'upper', 'real3', .false.), &
       variable_info_t('wall', 'condition', 'string', .false.), &
+      variable_info_t('wall', 'name', 'string', .false.), &
+      variable_info_t('wall', 'moment_point', 'real3', .false.), &
+      variable_info_t('inlet', 'name', 'string', .false.), &
       variable_info_t('inlet', 'material', 'string', .true.), &
       variable_info_t('inlet', 'point', 'real3', .true.), &
       variable_info_t('inlet', 'direction', 'real3', .true.), &
@@ -122,7 +136,11 @@ module scene_reader
       variable_info_t('inlet', 'start_time', 'real', .false.), &
       variable_info_t('inlet', 'end_time', 'real', .false.), &
       variable_info_t('inlet', 'particles_per_cell', 'integer', .false.), &
-      variable_info_t('inlet', 'hydrostatic', 'logical', .false.)]
+      variable_info_t('inlet', 'hydrostatic', 'logical', .false.), &
+      variable_info_t('gauge', 'name', 'string', .true.), &
+      variable_info_t('gauge', 'kind', 'string', .true.), &
+      variable_info_t('gauge', 'point', 'real3', .true.), &
+      variable_info_t('gauge', 'radius', 'real', .false.)]
 
    !> Namelist buffers of string values are longer than the scene's fields, so that a value too long
    !> for its field is reported instead of cut.
@@ -235,7 +253,7 @@ contains
       if (.not. status%ok) return
       call read_singleton_groups(unit, file, scene, status)
       if (.not. status%ok) return
-      allocate (probe%materials(1), probe%bodies(1), probe%walls(1), probe%inlets(1))
+      allocate (probe%materials(1), probe%bodies(1), probe%walls(1), probe%inlets(1), probe%gauges(1))
       do g = 1, size(file%groups)
          group = file%groups(g)%name
          if (.not. any(repeated_groups == group)) cycle
@@ -283,7 +301,7 @@ contains
       character(len=*), intent(in) :: group
       character(len=:), allocatable :: name
       select case (group)
-      case ('material')
+      case ('material', 'wall', 'gauge')
          name = 'name'
       case ('body', 'inlet')
          name = 'material'
@@ -308,6 +326,12 @@ contains
          value = trim(scene%bodies(i)%material)
       case ('inlet')
          value = trim(scene%inlets(i)%material)
+      case ('wall')
+         ! an unnamed wall is selected by its default name (wall_<k>)
+         value = trim(scene%walls(i)%name)
+         if (len(value) == 0) value = default_name('wall', i)
+      case ('gauge')
+         value = trim(scene%gauges(i)%name)
       case default
          value = ''
       end select
@@ -326,6 +350,8 @@ contains
          if (allocated(scene%walls)) n = size(scene%walls)
       case ('inlet')
          if (allocated(scene%inlets)) n = size(scene%inlets)
+      case ('gauge')
+         if (allocated(scene%gauges)) n = size(scene%gauges)
       end select
    end function entry_count
 
@@ -442,13 +468,14 @@ contains
       type(body_spec_t) :: default_body
       type(wall_spec_t) :: default_wall
       type(inlet_spec_t) :: default_inlet
+      type(gauge_spec_t) :: default_gauge
       character(len=512) :: message
       character(len=:), allocatable :: group
       integer :: g, k, n, ios
 
       allocate (scene%materials(file%count('material')), scene%bodies(file%count('body')), &
-                scene%walls(file%count('wall')), scene%inlets(file%count('inlet')))
-      allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1))
+                scene%walls(file%count('wall')), scene%inlets(file%count('inlet')), scene%gauges(file%count('gauge')))
+      allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1), one%gauges(1))
       do g = 1, size(repeated_groups)
          group = trim(repeated_groups(g))
          n = file%count(group)
@@ -459,6 +486,7 @@ contains
             one%bodies(1) = default_body
             one%walls(1) = default_wall
             one%inlets(1) = default_inlet
+            one%gauges(1) = default_gauge
             message = ''
             call read_group(group, one, 1, ios, message, unit=unit)
             ! gfortran can also end a read that failed inside a group with iostat_end (`hydrostatic = 'yes'`).
@@ -479,6 +507,8 @@ contains
                scene%walls(k) = one%walls(1)
             case ('inlet')
                scene%inlets(k) = one%inlets(1)
+            case ('gauge')
+               scene%gauges(k) = one%gauges(1)
             end select
          end do
          if (k /= n) then
@@ -507,9 +537,11 @@ contains
          case ('body')
             where = group_context(file%path, group, k, material_detail(scene%bodies(k)%material))
          case ('wall')
-            where = group_context(file%path, group, k)
+            where = group_context(file%path, group, k, name_detail(scene%walls(k)%name))
          case ('inlet')
             where = group_context(file%path, group, k, material_detail(scene%inlets(k)%material))
+         case ('gauge')
+            where = group_context(file%path, group, k, name_detail(scene%gauges(k)%name))
          case default
             where = group_context(file%path, group, 0)
          end select
@@ -580,7 +612,7 @@ contains
          call status%fail(file%path//': group &'//group//label//': '//trim(message))
          return
       end if
-      allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1))
+      allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1), one%gauges(1))
       associate (items => file%groups(g)%items)
          do i = 1, size(items)
             prefix = file%path//': line '//int_text(items(i)%line)//': group &'//group//label
@@ -688,6 +720,8 @@ contains
          call read_wall_group(scene%walls(k), ios, message, unit, text)
       case ('inlet')
          call read_inlet_group(scene%inlets(k), ios, message, unit, text)
+      case ('gauge')
+         call read_gauge_group(scene%gauges(k), ios, message, unit, text)
       case default
          ios = value_too_long
          message = 'no namelist group &'//group
@@ -713,14 +747,15 @@ contains
       integer, intent(in), optional :: unit
       character(len=*), intent(in), optional :: text
       real(rp) :: end_time, cfl, dt, output_interval, flip_fraction, theta, progress_interval, floor_size, &
-                  checkpoint_interval_wall, speed_limit, rebalance_threshold
+                  checkpoint_interval_wall, speed_limit, rebalance_threshold, load_interval
       character(len=text_len) :: output_dir, update_scheme
       logical :: overwrite, particle_output, grid_output
       integer(i8) :: max_steps, checkpoint_interval_steps
       integer :: checkpoints_kept, rebalance_interval
       namelist /run/ end_time, cfl, dt, output_interval, output_dir, overwrite, update_scheme, flip_fraction, &
          theta, max_steps, progress_interval, floor_size, particle_output, grid_output, checkpoint_interval_steps, &
-         checkpoint_interval_wall, checkpoints_kept, speed_limit, rebalance_threshold, rebalance_interval
+         checkpoint_interval_wall, checkpoints_kept, speed_limit, rebalance_threshold, rebalance_interval, &
+         load_interval
 
       end_time = control%end_time
       cfl = control%cfl
@@ -742,6 +777,7 @@ contains
       speed_limit = control%speed_limit
       rebalance_threshold = control%rebalance_threshold
       rebalance_interval = control%rebalance_interval
+      load_interval = control%load_interval
       if (present(text)) then
          read (text, nml=run, iostat=ios, iomsg=message)
       else
@@ -770,6 +806,7 @@ contains
       control%speed_limit = speed_limit
       control%rebalance_threshold = rebalance_threshold
       control%rebalance_interval = rebalance_interval
+      control%load_interval = load_interval
    end subroutine read_run_group
 
    subroutine read_grid_group(spec, ios, message, unit, text)
@@ -807,7 +844,9 @@ contains
       integer, intent(in), optional :: unit
       character(len=*), intent(in), optional :: text
       character(len=text_len) :: x_min, x_max, y_min, y_max, z_min, z_max
-      namelist /box_walls/ x_min, x_max, y_min, y_max, z_min, z_max
+      character(len=text_len) :: x_min_name, x_max_name, y_min_name, y_max_name, z_min_name, z_max_name
+      namelist /box_walls/ x_min, x_max, y_min, y_max, z_min, z_max, &
+         x_min_name, x_max_name, y_min_name, y_max_name, z_min_name, z_max_name
 
       x_min = spec%wall(1, 1)
       x_max = spec%wall(2, 1)
@@ -815,6 +854,12 @@ contains
       y_max = spec%wall(2, 2)
       z_min = spec%wall(1, 3)
       z_max = spec%wall(2, 3)
+      x_min_name = spec%wall_name(1, 1)
+      x_max_name = spec%wall_name(2, 1)
+      y_min_name = spec%wall_name(1, 2)
+      y_max_name = spec%wall_name(2, 2)
+      z_min_name = spec%wall_name(1, 3)
+      z_max_name = spec%wall_name(2, 3)
       if (present(text)) then
          read (text, nml=box_walls, iostat=ios, iomsg=message)
       else
@@ -826,6 +871,12 @@ contains
       call check_length('y_max', y_max, len(spec%wall), ios, message)
       call check_length('z_min', z_min, len(spec%wall), ios, message)
       call check_length('z_max', z_max, len(spec%wall), ios, message)
+      call check_length('x_min_name', x_min_name, len(spec%wall_name), ios, message)
+      call check_length('x_max_name', x_max_name, len(spec%wall_name), ios, message)
+      call check_length('y_min_name', y_min_name, len(spec%wall_name), ios, message)
+      call check_length('y_max_name', y_max_name, len(spec%wall_name), ios, message)
+      call check_length('z_min_name', z_min_name, len(spec%wall_name), ios, message)
+      call check_length('z_max_name', z_max_name, len(spec%wall_name), ios, message)
       if (ios /= 0) return
       spec%wall(1, 1) = lower_case(adjustl(x_min))
       spec%wall(2, 1) = lower_case(adjustl(x_max))
@@ -833,6 +884,12 @@ contains
       spec%wall(2, 2) = lower_case(adjustl(y_max))
       spec%wall(1, 3) = lower_case(adjustl(z_min))
       spec%wall(2, 3) = lower_case(adjustl(z_max))
+      spec%wall_name(1, 1) = x_min_name(1:len(spec%wall_name))
+      spec%wall_name(2, 1) = x_max_name(1:len(spec%wall_name))
+      spec%wall_name(1, 2) = y_min_name(1:len(spec%wall_name))
+      spec%wall_name(2, 2) = y_max_name(1:len(spec%wall_name))
+      spec%wall_name(1, 3) = z_min_name(1:len(spec%wall_name))
+      spec%wall_name(2, 3) = z_max_name(1:len(spec%wall_name))
    end subroutine read_box_walls_group
 
    subroutine read_gravity_group(vector, ios, message, unit, text)
@@ -920,12 +977,13 @@ contains
       character(len=*), intent(inout) :: message
       integer, intent(in), optional :: unit
       character(len=*), intent(in), optional :: text
-      character(len=text_len) :: material
+      character(len=text_len) :: name, material
       real(rp) :: lower(3), upper(3), velocity(3), free_surface_level
       integer :: particles_per_cell
       logical :: hydrostatic
-      namelist /body/ material, lower, upper, particles_per_cell, velocity, hydrostatic, free_surface_level
+      namelist /body/ name, material, lower, upper, particles_per_cell, velocity, hydrostatic, free_surface_level
 
+      name = spec%name
       material = spec%material
       lower = spec%lower
       upper = spec%upper
@@ -938,8 +996,10 @@ contains
       else
          read (unit, nml=body, iostat=ios, iomsg=message)
       end if
+      call check_length('name', name, len(spec%name), ios, message)
       call check_length('material', material, len(spec%material), ios, message)
       if (ios /= 0) return
+      spec%name = name(1:len(spec%name))
       spec%material = material(1:len(spec%material))
       spec%lower = lower
       spec%upper = upper
@@ -955,27 +1015,32 @@ contains
       character(len=*), intent(inout) :: message
       integer, intent(in), optional :: unit
       character(len=*), intent(in), optional :: text
-      character(len=text_len) :: condition
-      real(rp) :: point(3), normal(3), lower(3), upper(3)
-      namelist /wall/ point, normal, lower, upper, condition
+      character(len=text_len) :: condition, name
+      real(rp) :: point(3), normal(3), lower(3), upper(3), moment_point(3)
+      namelist /wall/ point, normal, lower, upper, condition, name, moment_point
 
       point = spec%point
       normal = spec%normal
       lower = spec%lower
       upper = spec%upper
       condition = spec%condition
+      name = spec%name
+      moment_point = spec%moment_point
       if (present(text)) then
          read (text, nml=wall, iostat=ios, iomsg=message)
       else
          read (unit, nml=wall, iostat=ios, iomsg=message)
       end if
       call check_length('condition', condition, len(spec%condition), ios, message)
+      call check_length('name', name, len(spec%name), ios, message)
       if (ios /= 0) return
       spec%point = point
       spec%normal = normal
       spec%lower = lower
       spec%upper = upper
       spec%condition = lower_case(adjustl(condition))
+      spec%name = name(1:len(spec%name))
+      spec%moment_point = moment_point
    end subroutine read_wall_group
 
    subroutine read_inlet_group(spec, ios, message, unit, text)
@@ -984,13 +1049,14 @@ contains
       character(len=*), intent(inout) :: message
       integer, intent(in), optional :: unit
       character(len=*), intent(in), optional :: text
-      character(len=text_len) :: material
+      character(len=text_len) :: name, material
       real(rp) :: point(3), direction(3), height, width, velocity, start_time, end_time
       integer :: particles_per_cell
       logical :: hydrostatic
-      namelist /inlet/ material, point, direction, height, width, velocity, start_time, end_time, &
+      namelist /inlet/ name, material, point, direction, height, width, velocity, start_time, end_time, &
          particles_per_cell, hydrostatic
 
+      name = spec%name
       material = spec%material
       point = spec%point
       direction = spec%direction
@@ -1006,8 +1072,10 @@ contains
       else
          read (unit, nml=inlet, iostat=ios, iomsg=message)
       end if
+      call check_length('name', name, len(spec%name), ios, message)
       call check_length('material', material, len(spec%material), ios, message)
       if (ios /= 0) return
+      spec%name = name(1:len(spec%name))
       spec%material = material(1:len(spec%material))
       spec%point = point
       spec%direction = direction
@@ -1019,4 +1087,32 @@ contains
       spec%particles_per_cell = particles_per_cell
       spec%hydrostatic = hydrostatic
    end subroutine read_inlet_group
+
+   subroutine read_gauge_group(spec, ios, message, unit, text)
+      type(gauge_spec_t), intent(inout) :: spec
+      integer, intent(out) :: ios
+      character(len=*), intent(inout) :: message
+      integer, intent(in), optional :: unit
+      character(len=*), intent(in), optional :: text
+      character(len=text_len) :: name, kind
+      real(rp) :: point(3), radius
+      namelist /gauge/ name, kind, point, radius
+
+      name = spec%name
+      kind = spec%kind
+      point = spec%point
+      radius = spec%radius
+      if (present(text)) then
+         read (text, nml=gauge, iostat=ios, iomsg=message)
+      else
+         read (unit, nml=gauge, iostat=ios, iomsg=message)
+      end if
+      call check_length('name', name, len(spec%name), ios, message)
+      call check_length('kind', kind, len(spec%kind), ios, message)
+      if (ios /= 0) return
+      spec%name = name(1:len(spec%name))
+      spec%kind = lower_case(adjustl(kind))
+      spec%point = point
+      spec%radius = radius
+   end subroutine read_gauge_group
 end module scene_reader

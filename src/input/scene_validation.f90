@@ -1,18 +1,19 @@
 !> Checks of a scene's values (the allowed ranges of docs/input.md) and resolution of the values that
 !> default to something derived (`output_interval = 0`, `floor_size = 0`, grid cell counts, material
-!> indices of bodies). Both work on a whole scene, whatever file(s) its values came from.
+!> indices of bodies, default names, gauge radii, moment points). Both work on a whole scene, whatever
+!> file(s) its values came from.
 module scene_validation
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use kinds, only: rp, i8, name_len
    use error_status, only: status_t
    use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
-                                inlet_spec_t, opening_far_end, wall_none, wall_slip, wall_no_slip, model_newtonian_fluid, &
-                                model_linear_elastic
+                                inlet_spec_t, gauge_spec_t, opening_far_end, wall_none, wall_slip, wall_no_slip, &
+                                model_newtonian_fluid, model_linear_elastic, gauge_pressure, gauge_level, gauge_velocity
    use input_text, only: int_text, real_text, quoted_list, group_context, ordinal
    implicit none
    private
 
-   public :: validate_scene, resolve_scene, find_material
+   public :: validate_scene, resolve_scene, find_material, default_name, side_name
 
    !> Accepted `&material stabilization=` keywords in their canonical spelling (compared without case).
    character(len=*), parameter, public :: stabilization_keywords(*) = [character(len=5) :: 'none', 'C0', 'NB', 'FOAL1']
@@ -34,6 +35,9 @@ module scene_validation
    !> Accepted `&material model=` keywords (stored lower case).
    character(len=*), parameter, public :: model_keywords(*) = &
       [character(len=15) :: model_newtonian_fluid, model_linear_elastic]
+   !> Accepted `&gauge kind=` keywords (stored lower case).
+   character(len=*), parameter, public :: gauge_kind_keywords(*) = &
+      [character(len=8) :: gauge_pressure, gauge_level, gauge_velocity]
 
    !> Relative tolerance of "extent is a whole multiple of cell_size".
    real(rp), parameter :: multiple_tolerance = 1.0e-9_rp
@@ -44,6 +48,16 @@ module scene_validation
 
    character(len=1), parameter :: axis_letter(3) = ['x', 'y', 'z']
 
+   !> One name of the load namespace (box sides that are walls, &wall, &inlet, &body), for the
+   !> uniqueness check: the resolved name, whether the scene gave it, and how messages name its place.
+   type :: load_name_t
+      character(len=name_len) :: name = ''
+      logical :: given = .false.
+      character(len=:), allocatable :: owner      !< "the 2nd &wall", "the &box_walls side x_max"
+      character(len=:), allocatable :: where      !< group context of the variable that sets it
+      character(len=:), allocatable :: variable   !< "name", "x_max_name"
+   end type load_name_t
+
 contains
 
    !> Check every value of `scene` against its allowed range. `path` names the file in messages.
@@ -53,7 +67,7 @@ contains
       type(scene_t), intent(in) :: scene
       character(len=*), intent(in) :: path
       type(status_t), intent(inout) :: status
-      integer :: m, b, w, i
+      integer :: m, b, w, i, g
 
       call validate_run(scene%run, path, status)
       if (status%ok) call validate_grid(scene%grid, path, status)
@@ -93,6 +107,13 @@ contains
             if (.not. status%ok) return
          end do
       end if
+      if (allocated(scene%gauges)) then
+         do g = 1, size(scene%gauges)
+            call validate_gauge(scene%gauges, g, scene%grid, path, status)
+            if (.not. status%ok) return
+         end do
+      end if
+      call validate_load_names(scene, path, status)
    end subroutine validate_scene
 
    pure integer function body_count(scene)
@@ -100,6 +121,12 @@ contains
       body_count = 0
       if (allocated(scene%bodies)) body_count = size(scene%bodies)
    end function body_count
+
+   pure integer function wall_count(scene)
+      type(scene_t), intent(in) :: scene
+      wall_count = 0
+      if (allocated(scene%walls)) wall_count = size(scene%walls)
+   end function wall_count
 
    pure integer function inlet_count(scene)
       type(scene_t), intent(in) :: scene
@@ -111,7 +138,7 @@ contains
    !> scene that `validate_scene` accepted.
    subroutine resolve_scene(scene)
       type(scene_t), intent(inout) :: scene
-      integer :: k, b, i
+      integer :: k, b, i, w, g, side
 
       associate (run => scene%run, grid => scene%grid)
          ! Validated >= 0, so not > 0 means 0.
@@ -121,20 +148,99 @@ contains
          do k = 1, grid%dim
             grid%ncells(k) = nint(grid%extent(k) / grid%cell_size)
          end do
+         ! sides without a wall keep the empty name: they carry no load
+         do k = 1, 3
+            do side = 1, 2
+               if (grid%wall(side, k) /= wall_none .and. len_trim(grid%wall_name(side, k)) == 0) then
+                  grid%wall_name(side, k) = side_name(side, k)
+               end if
+            end do
+         end do
       end associate
       if (.not. allocated(scene%bodies)) allocate (scene%bodies(0))
       do b = 1, size(scene%bodies)
          scene%bodies(b)%material_index = find_material(scene%materials, scene%bodies(b)%material)
+         if (len_trim(scene%bodies(b)%name) == 0) scene%bodies(b)%name = default_name('body', b)
       end do
       if (.not. allocated(scene%walls)) allocate (scene%walls(0))     ! (wall normals are made unit where walls are built)
+      do w = 1, size(scene%walls)
+         associate (wall => scene%walls(w))
+            if (len_trim(wall%name) == 0) wall%name = default_name('wall', w)
+            ! each component not given is the wall point's
+            where (wall%moment_point >= huge(1.0_rp)) wall%moment_point = wall%point
+         end associate
+      end do
       if (.not. allocated(scene%inlets)) allocate (scene%inlets(0))
       do i = 1, size(scene%inlets)
          associate (inlet => scene%inlets(i))
             inlet%material_index = find_material(scene%materials, inlet%material)
             inlet%direction(1:scene%grid%dim) = inlet%direction(1:scene%grid%dim) / norm2(inlet%direction(1:scene%grid%dim))
+            if (len_trim(inlet%name) == 0) inlet%name = default_name('inlet', i)
+         end associate
+      end do
+      if (.not. allocated(scene%gauges)) allocate (scene%gauges(0))
+      do g = 1, size(scene%gauges)
+         associate (gauge => scene%gauges(g))
+            ! Validated >= 0, so not > 0 means 0: one cell, a level gauge's column half a cell either side.
+            if (.not. gauge%radius > 0.0_rp) then
+               if (gauge%kind == gauge_level) then
+                  gauge%radius = 0.5_rp * scene%grid%cell_size
+               else
+                  gauge%radius = scene%grid%cell_size
+               end if
+            end if
          end associate
       end do
    end subroutine resolve_scene
+
+   !> Default name of the k-th entry of a repeated group that carries loads: `wall_<k>`, `inlet_<k>`,
+   !> `body_<k>`.
+   pure function default_name(group, k) result(name)
+      character(len=*), intent(in) :: group
+      integer, intent(in) :: k
+      character(len=:), allocatable :: name
+      name = trim(group)//'_'//int_text(k)
+   end function default_name
+
+   !> Name of a side of the scene box, and its `&box_walls` variable: `x_min` (side 1, axis 1) ... `z_max`.
+   pure function side_name(side, axis) result(name)
+      integer, intent(in) :: side, axis
+      character(len=5) :: name
+      name = axis_letter(axis)//merge('_min', '_max', side == 1)
+   end function side_name
+
+   !> A name is a plain identifier: a letter, then letters, digits or underscores (no blanks), so that
+   !> it can prefix csv columns and be used in plots and scripts as is.
+   pure logical function is_identifier(name)
+      character(len=*), intent(in) :: name
+      integer :: i
+      character :: c
+      is_identifier = .false.
+      if (len_trim(name) == 0) return
+      do i = 1, len_trim(name)
+         c = name(i:i)
+         if (is_letter(c)) cycle
+         if (i > 1 .and. (c == '_' .or. (c >= '0' .and. c <= '9'))) cycle
+         return
+      end do
+      is_identifier = .true.
+   end function is_identifier
+
+   pure logical function is_letter(c)
+      character, intent(in) :: c
+      is_letter = (c >= 'a' .and. c <= 'z') .or. (c >= 'A' .and. c <= 'Z')
+   end function is_letter
+
+   !> Fail unless the name a scene gives (empty: the default name) is a plain identifier.
+   subroutine check_name(where, variable, name, status)
+      character(len=*), intent(in) :: where, variable, name
+      type(status_t), intent(inout) :: status
+      if (.not. status%ok .or. len_trim(name) == 0) return
+      if (.not. is_identifier(name)) then
+         call status%fail(where//': variable '//variable//" must be a plain identifier (a letter, then letters, "// &
+                          "digits or '_'), got '"//trim(name)//"'")
+      end if
+   end subroutine check_name
 
    !> Index of the material called `name` (exact match); 0 if there is none.
    pure integer function find_material(materials, name) result(found)
@@ -193,6 +299,7 @@ contains
       if (run%rebalance_interval < 1) then
          call status%fail(where//': variable rebalance_interval must be >= 1, got '//int_text(run%rebalance_interval))
       end if
+      call check_real(where, 'load_interval', run%load_interval, status, at_least=0.0_rp)
    end subroutine validate_run
 
    subroutine validate_grid(grid, path, status)
@@ -261,6 +368,20 @@ contains
                                 trim(grid%wall(side, k))//"'")
                return
             end if
+         end do
+      end do
+      ! a name labels the loads of a wall: an open side has none
+      do k = 1, 3
+         do side = 1, 2
+            variable = side_name(side, k)
+            if (len_trim(grid%wall_name(side, k)) == 0) cycle
+            if (grid%wall(side, k) == wall_none) then
+               call status%fail(where//': variable '//variable//"_name names side "//variable//", which is not a wall ("// &
+                                variable//" = '"//wall_none//"')")
+               return
+            end if
+            call check_name(where, variable//'_name', grid%wall_name(side, k), status)
+            if (.not. status%ok) return
          end do
       end do
    end subroutine validate_walls
@@ -365,6 +486,8 @@ contains
          return
       end if
       where = group_context(path, 'body', b, "material '"//trim(body%material)//"'")
+      call check_name(where, 'name', body%name, status)
+      if (.not. status%ok) return
       if (find_material(materials, body%material) == 0) then
          do m = 1, size(materials)
             declared(m) = materials(m)%name
@@ -418,12 +541,15 @@ contains
       character(len=:), allocatable :: where
       integer :: k
 
-      where = group_context(path, 'wall', w)
+      where = group_context(path, 'wall', w, name_detail(wall%name))
+      call check_name(where, 'name', wall%name, status)
       do k = 1, dim
          call check_real(where, 'point('//int_text(k)//')', wall%point(k), status)
          call check_real(where, 'normal('//int_text(k)//')', wall%normal(k), status)
          call check_real(where, 'lower('//int_text(k)//')', wall%lower(k), status)
          call check_real(where, 'upper('//int_text(k)//')', wall%upper(k), status)
+         ! huge: not given (the component of point)
+         call check_real(where, 'moment_point('//int_text(k)//')', wall%moment_point(k), status)
       end do
       if (.not. status%ok) return
       if (norm2(wall%normal(1:dim)) < tiny(1.0_rp)**0.25_rp) then
@@ -460,6 +586,8 @@ contains
 
       dim = grid%dim
       where = group_context(path, 'inlet', i, "material '"//trim(inlet%material)//"'")
+      call check_name(where, 'name', inlet%name, status)
+      if (.not. status%ok) return
       m = find_material(materials, inlet%material)
       if (m == 0) then
          call status%fail(where//': variable material must name a declared &material, got '''//trim(inlet%material)//"'")
@@ -509,6 +637,134 @@ contains
          if (.not. status%ok) return
       end do
    end subroutine validate_inlet
+
+   subroutine validate_gauge(gauges, g, grid, path, status)
+      type(gauge_spec_t), intent(in) :: gauges(:)
+      integer, intent(in) :: g
+      type(grid_spec_t), intent(in) :: grid
+      character(len=*), intent(in) :: path
+      type(status_t), intent(inout) :: status
+      character(len=:), allocatable :: where
+      real(rp) :: tolerance
+      integer :: k, other
+
+      associate (gauge => gauges(g))
+         if (len_trim(gauge%name) == 0) then
+            call status%fail(group_context(path, 'gauge', g)//': variable name is required')
+            return
+         end if
+         where = group_context(path, 'gauge', g, name_detail(gauge%name))
+         call check_name(where, 'name', gauge%name, status)
+         if (.not. status%ok) return
+         ! gauges.csv is a file of its own: gauge names need only differ from each other
+         do other = 1, g - 1
+            if (gauges(other)%name == gauge%name) then
+               call status%fail(where//": variable name '"//trim(gauge%name)//"' is already used by the "// &
+                                ordinal(other)//' &gauge')
+               return
+            end if
+         end do
+         if (all(gauge%kind /= gauge_kind_keywords)) then
+            call status%fail(where//': variable kind must be one of '//quoted_list(gauge_kind_keywords)//", got '"// &
+                             trim(gauge%kind)//"'")
+            return
+         end if
+         do k = 1, grid%dim
+            call check_real(where, 'point('//int_text(k)//')', gauge%point(k), status)
+         end do
+         call check_real(where, 'radius', gauge%radius, status, at_least=0.0_rp)
+         if (.not. status%ok) return
+         ! the scene box is axis-aligned in the world frame, whatever the grid's rotation (as for &inlet)
+         tolerance = inside_tolerance * grid%cell_size
+         do k = 1, grid%dim
+            if (gauge%point(k) < grid%origin(k) - tolerance .or. &
+                gauge%point(k) > grid%origin(k) + grid%extent(k) + tolerance) then
+               call status%fail(where//': variable point('//int_text(k)//') must lie in the scene box of &grid, '// &
+                                real_text(grid%origin(k))//' .. '//real_text(grid%origin(k) + grid%extent(k))// &
+                                ', got '//real_text(gauge%point(k)))
+               return
+            end if
+         end do
+      end associate
+   end subroutine validate_gauge
+
+   !> The names of the walls (box sides that are walls, &wall), inlets and bodies are one namespace: the
+   !> columns of loads.csv and bodies.csv, and the labels of their plots. A name the scene gives must
+   !> differ from every other name, given or default (`wall_<k>`, `x_min`, `inlet_<k>`, `body_<k>`); the
+   !> message names the variable the scene wrote, so it is always a name the user can change.
+   subroutine validate_load_names(scene, path, status)
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: path
+      type(status_t), intent(inout) :: status
+      type(load_name_t), allocatable :: names(:)
+      character(len=:), allocatable :: owner
+      integer :: n, k, side, i, j
+
+      allocate (names(6 + wall_count(scene) + inlet_count(scene) + body_count(scene)))
+      n = 0
+      do k = 1, 3
+         do side = 1, 2
+            if (scene%grid%wall(side, k) == wall_none) cycle
+            n = n + 1
+            call set_name(names(n), scene%grid%wall_name(side, k), side_name(side, k), &
+                          'the &box_walls side '//side_name(side, k), group_context(path, 'box_walls', 0), &
+                          side_name(side, k)//'_name')
+         end do
+      end do
+      do i = 1, wall_count(scene)
+         n = n + 1
+         call set_name(names(n), scene%walls(i)%name, default_name('wall', i), 'the '//ordinal(i)//' &wall', &
+                       group_context(path, 'wall', i, name_detail(scene%walls(i)%name)), 'name')
+      end do
+      do i = 1, inlet_count(scene)
+         n = n + 1
+         call set_name(names(n), scene%inlets(i)%name, default_name('inlet', i), 'the '//ordinal(i)//' &inlet', &
+                       group_context(path, 'inlet', i, "material '"//trim(scene%inlets(i)%material)//"'"), 'name')
+      end do
+      do i = 1, body_count(scene)
+         n = n + 1
+         call set_name(names(n), scene%bodies(i)%name, default_name('body', i), 'the '//ordinal(i)//' &body', &
+                       group_context(path, 'body', i, "material '"//trim(scene%bodies(i)%material)//"'"), 'name')
+      end do
+
+      ! Two default names never clash, so every clash involves a given name: report it there (the later
+      ! of two given names).
+      do j = 1, n
+         if (.not. names(j)%given) cycle
+         do i = 1, n
+            if (i == j .or. names(i)%name /= names(j)%name) cycle
+            if (names(i)%given .and. i > j) cycle
+            owner = names(i)%owner
+            if (.not. names(i)%given) owner = owner//' (its default name)'
+            call status%fail(names(j)%where//': variable '//names(j)%variable//" '"//trim(names(j)%name)// &
+                             "' is already used by "//owner)
+            return
+         end do
+      end do
+   end subroutine validate_load_names
+
+   !> One entry of the load namespace: `given` if not empty, else `default`.
+   subroutine set_name(entry, given, default, owner, where, variable)
+      type(load_name_t), intent(out) :: entry
+      character(len=*), intent(in) :: given, default, owner, where, variable
+      entry%given = len_trim(given) > 0
+      if (entry%given) then
+         entry%name = given
+      else
+         entry%name = default
+      end if
+      entry%owner = owner
+      entry%where = where
+      entry%variable = variable
+   end subroutine set_name
+
+   !> "name 'left'" for a message's group context; '' when no name is given.
+   pure function name_detail(name) result(detail)
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: detail
+      detail = ''
+      if (len_trim(name) > 0) detail = "name '"//trim(name)//"'"
+   end function name_detail
 
    !> Fail with "<where>: variable <variable> must be <range>, got <value>" unless `value` is finite and
    !> inside the range given by the optional bounds.

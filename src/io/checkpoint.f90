@@ -38,7 +38,7 @@ module checkpoint
    character(len=*), parameter, public :: checkpoint_format = 'flotsam checkpoint'
    !> 2: grid rotation; 3: cuts sized (ranks + 1) x 3 for any rank grid (load balancing); their ends, the
    !> active box, need not be the grid's (a version-3 file of the whole grid is read the same way)
-   integer, parameter, public :: checkpoint_format_version = 3
+   integer, parameter, public :: checkpoint_format_version = 4
 
    public :: write_checkpoint, read_checkpoint, latest_checkpoint_path
 
@@ -78,6 +78,7 @@ contains
       call file%write_attribute('dt', solver%dt, status)
       call file%write_attribute('mass_tolerance', solver%mass_tolerance, status)
       call file%write_attribute('next_output_time', progress%next_output_time, status)
+      call write_series_state(solver, file, status)
       call write_particles(solver, file, status)
       call write_outputs(solver, progress, file, status)
       ! last: a file without it was not finished (cannot happen after the rename, but costs nothing)
@@ -311,6 +312,7 @@ contains
       call file%read_slab('particles/material', slab, material, status)
       call file%read_slab('particles/id', slab, id, status)
       call read_outputs(file, progress, status)
+      call read_series_state(solver, file, status)
       if (status%ok .and. n > 0) then
          if (any(material(1:n) < 1 .or. material(1:n) > size(solver%materials))) &
             call status%fail(where//' holds a particle of an unknown material')
@@ -352,6 +354,43 @@ contains
       progress%restarted = .true.
       progress%restart_step = step
    end subroutine read_checkpoint
+
+   !> What the series of loads.csv, gauges.csv and bodies.csv carry from row to row (load_records): the
+   !> last row's time, the wall impulse since then, the bodies' momentum and 2-D angle at that row. With
+   !> them a restart continues the rows bit for bit. Attributes of zero size are not written.
+   subroutine write_series_state(solver, file, status)
+      type(solver_t), intent(in) :: solver
+      type(hdf5_file_t), intent(inout) :: file
+      type(status_t), intent(inout) :: status
+      call file%write_attribute('last_load_row_time', solver%loads%last_row_time, status)
+      if (size(solver%loads%impulse) > 0) &
+         call file%write_attribute('load_impulse', reshape(solver%loads%impulse, [size(solver%loads%impulse)]), status)
+      if (solver%bodies%count() > 0) then
+         call file%write_attribute('body_momentum', reshape(solver%bodies%previous_momentum, &
+                                                            [size(solver%bodies%previous_momentum)]), status)
+         call file%write_attribute('body_angle', solver%bodies%previous_angle, status)
+      end if
+   end subroutine write_series_state
+
+   subroutine read_series_state(solver, file, status)
+      type(solver_t), intent(inout) :: solver
+      type(hdf5_file_t), intent(inout) :: file
+      type(status_t), intent(inout) :: status
+      real(rp), allocatable :: flat(:)
+      call file%read_attribute('last_load_row_time', solver%loads%last_row_time, status)
+      if (size(solver%loads%impulse) > 0) then
+         allocate (flat(size(solver%loads%impulse)))
+         call file%read_attribute('load_impulse', flat, status)
+         if (status%ok) solver%loads%impulse = reshape(flat, shape(solver%loads%impulse))
+         deallocate (flat)
+      end if
+      if (solver%bodies%count() > 0) then
+         allocate (flat(size(solver%bodies%previous_momentum)))
+         call file%read_attribute('body_momentum', flat, status)
+         if (status%ok) solver%bodies%previous_momentum = reshape(flat, shape(solver%bodies%previous_momentum))
+         call file%read_attribute('body_angle', solver%bodies%previous_angle, status)
+      end if
+   end subroutine read_series_state
 
    !> The checkpoint must come from a scene with the same grid and materials.
    subroutine check_scene(file, scene, where, status)

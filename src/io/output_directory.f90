@@ -11,7 +11,7 @@ module output_directory
    use error_status, only: status_t
    use file_system, only: path_exists, make_directory, remove_file
    use output_layout, only: fields_folder, checkpoint_folder, fields_file, checkpoint_file, particles_xdmf, &
-                            grid_xdmf, latest_checkpoint, temporary_suffix
+                            grid_xdmf, latest_checkpoint, temporary_suffix, loads_csv, gauges_csv, bodies_csv
    use status_broadcast, only: broadcast_status
    implicit none
    private
@@ -98,6 +98,9 @@ contains
       call remove(trim(dir)//'/'//run_marker, removed)
       call remove(trim(dir)//'/'//particles_xdmf, removed)
       call remove(trim(dir)//'/'//grid_xdmf, removed)
+      call remove(trim(dir)//'/'//loads_csv, removed)
+      call remove(trim(dir)//'/'//gauges_csv, removed)
+      call remove(trim(dir)//'/'//bodies_csv, removed)
       index = 0
       do
          if (.not. path_exists(trim(dir)//'/'//fields_file(index))) exit

@@ -17,6 +17,10 @@ module output_layout
    character(len=*), parameter, public :: grid_xdmf = 'grid.xmf'
    character(len=*), parameter, public :: latest_checkpoint = 'latest'
    character(len=*), parameter, public :: temporary_suffix = '.tmp'
+   !> The time series of loads, gauges and bodies (load_records, docs/output.md).
+   character(len=*), parameter, public :: loads_csv = 'loads.csv'
+   character(len=*), parameter, public :: gauges_csv = 'gauges.csv'
+   character(len=*), parameter, public :: bodies_csv = 'bodies.csv'
 
    public :: fields_file, checkpoint_file
 

@@ -9,6 +9,12 @@
 !>   no_slip    v := 0
 !>   prescribed v := v_0 (the feeder of an inlet, algorithms.md section 4.3)
 !> A wall may be active for a time window only (an inlet's opening and its closing wall).
+!>
+!> Loads (docs/theory.md section 3.2, algorithms.md section 9.1): the constraint's change of nodal
+!> momentum m_i (v_i^c - v_i^*) and the safeguard's change of particle momentum m_p (v_p^c - v_p) are the
+!> impulse the wall gives the material; walls applied in turn each keep the change they made, so the
+!> impulses at a corner split between the walls and add up exactly. A node shared with other ranks is
+!> counted by one of them only (`counted`).
 module boundary_walls
    use kinds, only: rp
    use scene_description, only: wall_spec_t, grid_spec_t, wall_none, wall_no_slip
@@ -38,9 +44,18 @@ module boundary_walls
       logical :: active = .true.
       integer :: axis = 0                  !< k if the grid-frame normal is +-e_k, else 0
       integer, allocatable :: nodes(:)     !< local nodes this rank constrains
+      integer :: load = 0                  !< the entry of loads.csv this wall's impulse goes to (0: none)
+      real(rp) :: moment_point(3) = 0.0_rp !< the point its moment is taken about (grid frame)
+      !> the impulse of node nodes(i) counts here: this rank owns the node (no other rank counts it)
+      logical, allocatable :: counted(:)
+      real(rp), allocatable :: arm(:, :)   !< node position - moment_point (3, i), grid frame [m]
    end type wall_t
 
-   public :: build_walls, make_wall, set_wall_activity, apply_wall_constraints, keep_particles_inside, behind_wall
+   !> Rows of an impulse accumulator (impulse_rows, wall): force impulse (3), then moment impulse (3), grid frame.
+   integer, parameter, public :: impulse_rows = 6
+
+   public :: build_walls, box_side_walls, make_wall, set_wall_activity, apply_wall_constraints, keep_particles_inside, &
+             behind_wall
 
 contains
 
@@ -64,7 +79,8 @@ contains
       do w = 1, size(specs)
          kind = wall_kind_slip
          if (specs(w)%condition == wall_no_slip) kind = wall_kind_no_slip
-         walls(w) = make_wall(grid, specs(w)%point, specs(w)%normal, specs(w)%lower, specs(w)%upper, grid%h, kind)
+         walls(w) = make_wall(grid, specs(w)%point, specs(w)%normal, specs(w)%lower, specs(w)%upper, grid%h, kind, &
+                              load=w, moment_point=specs(w)%moment_point)
       end do
    end subroutine build_walls_of
 
@@ -82,6 +98,7 @@ contains
          do side = 1, 2
             if (grid%wall(side, k) == wall_none) cycle
             wall%condition = grid%wall(side, k)
+            wall%name = grid%wall_name(side, k)
             wall%normal = 0.0_rp
             wall%normal(k) = merge(1.0_rp, -1.0_rp, side == 1)
             wall%lower = grid%origin
@@ -90,21 +107,28 @@ contains
             if (side == 2) wall%point(k) = upper(k)
             wall%lower(k) = wall%point(k)
             wall%upper(k) = wall%point(k)
+            ! the moment of a box side is taken about its lower corner
+            wall%moment_point = wall%point
             walls = [walls, wall]
          end do
       end do
    end function box_side_walls
 
    !> A wall through the world point `point` with the world unit normal `normal`, its extent lower..upper
-   !> (world) widened by `margin`, and the local nodes it constrains.
-   function make_wall(grid, point, normal, lower, upper, margin, kind, velocity, active_from, active_until) result(wall)
+   !> (world) widened by `margin`, and the local nodes it constrains. Its impulse goes to entry `load` of
+   !> loads.csv, its moment about the world point `moment_point` (default `point`).
+   function make_wall(grid, point, normal, lower, upper, margin, kind, velocity, active_from, active_until, load, &
+                      moment_point) result(wall)
       type(grid_t), intent(in) :: grid
       real(rp), intent(in) :: point(3), normal(3), lower(3), upper(3), margin
       integer, intent(in) :: kind
       real(rp), intent(in), optional :: velocity(3), active_from, active_until
+      integer, intent(in), optional :: load
+      real(rp), intent(in), optional :: moment_point(3)
       type(wall_t) :: wall
       integer :: dim, n, i, j, l, g(3)
       integer, allocatable :: found(:)
+      logical, allocatable :: owned(:)
       real(rp) :: x(3)
 
       dim = grid%dim
@@ -120,10 +144,15 @@ contains
       if (present(velocity)) wall%velocity(1:dim) = grid%frame%grid_vector(velocity(1:dim))
       if (present(active_from)) wall%active_from = active_from
       if (present(active_until)) wall%active_until = active_until
+      if (present(load)) wall%load = load
+      wall%moment_point = wall%point
+      if (present(moment_point)) then
+         if (all(abs(moment_point(1:dim)) < huge(1.0_rp))) wall%moment_point(1:dim) = grid%frame%grid_point(moment_point(1:dim))
+      end if
       ! the axis fast path of the safeguard needs a normal with exactly one non-zero component
       if (count(abs(wall%normal(1:dim)) > 0.0_rp) == 1) wall%axis = maxloc(abs(wall%normal(1:dim)), 1)
 
-      allocate (found(grid%node_count))
+      allocate (found(grid%node_count), owned(grid%node_count))
       n = 0
       x = 0.0_rp
       do l = grid%node_lo(3), grid%node_hi(3)
@@ -134,10 +163,18 @@ contains
                if (.not. behind_wall(wall, grid, x(1:dim), on_wall_tolerance * grid%h)) cycle
                n = n + 1
                found(n) = grid%local_node(g(1:dim))
+               owned(n) = grid%owns_node(g(1:dim))
             end do
          end do
       end do
       wall%nodes = found(1:n)
+      wall%counted = owned(1:n)
+      allocate (wall%arm(3, n))
+      wall%arm = 0.0_rp
+      do i = 1, n
+         g(1:dim) = grid%node_indices(found(i))
+         wall%arm(1:dim, i) = grid%origin(1:dim) + g(1:dim) * grid%h - wall%moment_point(1:dim)
+      end do
    end function make_wall
 
    !> True if the grid-frame point x lies on the wall or behind it (within `tolerance` in front), not
@@ -174,43 +211,68 @@ contains
 
    !> Constrain nodal velocities (eq. 14 for slip walls; zero for no-slip walls; v_0 for a feeder).
    !> Walls are applied in turn, which is exact at a corner of two orthogonal walls (algorithms.md
-   !> section 4.1); a prescribed velocity, listed last, wins.
-   pure subroutine apply_wall_constraints(walls, dim, velocity)
+   !> section 4.1); a prescribed velocity, listed last, wins. With `mass` (nodal masses) and `impulse`,
+   !> impulse(:, w) gains the momentum wall w gives the counted nodes, m_i (v_i^c - v_i^*), and its moment
+   !> (algorithms.md section 9.1).
+   pure subroutine apply_wall_constraints(walls, dim, velocity, mass, impulse)
       type(wall_t), intent(in) :: walls(:)
       integer, intent(in) :: dim
       real(rp), intent(inout) :: velocity(:, :)
+      real(rp), intent(in), optional :: mass(:)
+      real(rp), intent(inout), optional :: impulse(:, :)
       integer :: w, i, node
-      real(rp) :: vn
+      real(rp) :: vn, before(dim)
+      logical :: recording
+      recording = present(mass) .and. present(impulse)
       do w = 1, size(walls)
          if (.not. walls(w)%active) cycle
          associate (n => walls(w)%normal(1:dim))
-            select case (walls(w)%kind)
-            case (wall_kind_no_slip)
-               do i = 1, size(walls(w)%nodes)
-                  velocity(:, walls(w)%nodes(i)) = 0.0_rp
-               end do
-            case (wall_kind_prescribed)
-               do i = 1, size(walls(w)%nodes)
-                  velocity(:, walls(w)%nodes(i)) = walls(w)%velocity(1:dim)
-               end do
-            case default
-               do i = 1, size(walls(w)%nodes)
-                  node = walls(w)%nodes(i)
-                  vn = dot_product(velocity(:, node), n)
-                  if (vn < 0.0_rp) velocity(:, node) = velocity(:, node) - vn * n
-               end do
-            end select
+            do i = 1, size(walls(w)%nodes)
+               node = walls(w)%nodes(i)
+               before = velocity(:, node)
+               select case (walls(w)%kind)
+               case (wall_kind_no_slip)
+                  velocity(:, node) = 0.0_rp
+               case (wall_kind_prescribed)
+                  velocity(:, node) = walls(w)%velocity(1:dim)
+               case default
+                  vn = dot_product(before, n)
+                  if (vn >= 0.0_rp) cycle
+                  velocity(:, node) = before - vn * n
+               end select
+               if (recording) then
+                  if (walls(w)%counted(i)) call add_impulse(impulse(:, w), mass(node) * (velocity(:, node) - before), &
+                                                            walls(w)%arm(1:dim, i))
+               end if
+            end do
          end associate
       end do
    end subroutine apply_wall_constraints
 
+   !> impulse(1:3) += dp, impulse(4:6) += arm x dp (2-D: only the z component of the moment).
+   pure subroutine add_impulse(impulse, dp, arm)
+      real(rp), intent(inout) :: impulse(:)
+      real(rp), intent(in) :: dp(:), arm(:)
+      if (size(dp) == 2) then
+         impulse(1:2) = impulse(1:2) + dp
+         impulse(6) = impulse(6) + (arm(1) * dp(2) - arm(2) * dp(1))
+      else
+         impulse(1:3) = impulse(1:3) + dp
+         impulse(4) = impulse(4) + (arm(2) * dp(3) - arm(3) * dp(2))
+         impulse(5) = impulse(5) + (arm(3) * dp(1) - arm(1) * dp(3))
+         impulse(6) = impulse(6) + (arm(1) * dp(2) - arm(2) * dp(1))
+      end if
+   end subroutine add_impulse
+
    !> Particle safeguard (algorithms.md section 4.2): a particle found behind a wall (inside its extent
-   !> and depth) is put back onto it and loses its velocity component into the wall. Counts corrections.
-   subroutine keep_particles_inside(walls, grid, particles, corrections)
+   !> and depth) is put back onto it and loses its velocity component into the wall. Counts corrections;
+   !> impulse(:, w) gains the momentum (and its moment) that wall w gave the particles it corrected.
+   subroutine keep_particles_inside(walls, grid, particles, corrections, impulse)
       type(wall_t), intent(in) :: walls(:)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
       integer, intent(inout) :: corrections
+      real(rp), intent(inout) :: impulse(:, :)
       integer :: w, p, d
       real(rp) :: distance, vn, lowest(3), highest(3)
       d = particles%dim
@@ -224,7 +286,7 @@ contains
                if (walls(w)%normal(k) > 0.0_rp .and. lowest(k) - walls(w)%point(k) >= 0.0_rp) cycle
                if (walls(w)%normal(k) < 0.0_rp .and. highest(k) - walls(w)%point(k) <= 0.0_rp) cycle
             end associate
-            call keep_inside_axis_wall(walls(w), grid, particles, corrections)
+            call keep_inside_axis_wall(walls(w), grid, particles, corrections, impulse(:, w))
             cycle
          end if
          associate (n => walls(w)%normal(1:d), x0 => walls(w)%point(1:d))
@@ -234,7 +296,11 @@ contains
                if (.not. behind_wall(walls(w), grid, particles%x(:, p), 0.0_rp)) cycle
                particles%x(:, p) = particles%x(:, p) - distance * n
                vn = dot_product(particles%v(:, p), n)
-               if (vn < 0.0_rp) particles%v(:, p) = particles%v(:, p) - vn * n
+               if (vn < 0.0_rp) then
+                  particles%v(:, p) = particles%v(:, p) - vn * n
+                  call add_impulse(impulse(:, w), -particles%mass(p) * vn * n, &
+                                   particles%x(:, p) - walls(w)%moment_point(1:d))
+               end if
                corrections = corrections + 1
             end do
          end associate
@@ -258,13 +324,14 @@ contains
    end subroutine position_bounds
 
    !> The safeguard for a wall normal to grid axis k: the same operation without the dot products.
-   subroutine keep_inside_axis_wall(wall, grid, particles, corrections)
+   subroutine keep_inside_axis_wall(wall, grid, particles, corrections, impulse)
       type(wall_t), intent(in) :: wall
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
       integer, intent(inout) :: corrections
+      real(rp), intent(inout) :: impulse(:)
       integer :: p, k
-      real(rp) :: sense, x0
+      real(rp) :: sense, x0, dp(particles%dim)
       k = wall%axis
       sense = wall%normal(k)
       x0 = wall%point(k)
@@ -272,7 +339,12 @@ contains
          if (sense * (particles%x(k, p) - x0) >= 0.0_rp) cycle
          if (.not. behind_wall(wall, grid, particles%x(:, p), 0.0_rp)) cycle
          particles%x(k, p) = x0
-         if (sense * particles%v(k, p) < 0.0_rp) particles%v(k, p) = 0.0_rp
+         if (sense * particles%v(k, p) < 0.0_rp) then
+            dp = 0.0_rp
+            dp(k) = -particles%mass(p) * particles%v(k, p)
+            particles%v(k, p) = 0.0_rp
+            call add_impulse(impulse, dp, particles%x(:, p) - wall%moment_point(1:particles%dim))
+         end if
          corrections = corrections + 1
       end do
    end subroutine keep_inside_axis_wall

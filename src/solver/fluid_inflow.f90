@@ -51,17 +51,19 @@ module fluid_inflow
 contains
 
    !> The scene's inlets, and their walls appended to `walls` (after the scene's walls, so that the
-   !> feeder's prescribed velocity wins where they meet). first_id: the first id after the bodies'.
+   !> feeder's prescribed velocity wins where they meet). first_id: the first id after the bodies'. The
+   !> walls of inlet i report to load entry n + i, n the number of walls before them (the loads.csv order).
    subroutine build_inlets(scene, grid, first_id, inlets, walls)
       type(scene_t), intent(in) :: scene
       type(grid_t), intent(in) :: grid
       integer(i8), intent(in) :: first_id
       type(inlet_t), allocatable, intent(out) :: inlets(:)
       type(wall_t), allocatable, intent(inout) :: walls(:)
-      integer :: i, dim
+      integer :: i, dim, load
       real(rp) :: far_end(3), lower(3), upper(3), margin, volume_across
 
       dim = scene%grid%dim
+      load = size(walls)
       if (.not. allocated(scene%inlets)) then
          allocate (inlets(0))
          return
@@ -95,14 +97,15 @@ contains
             lower = min(spec%point, far_end)
             upper = max(spec%point, far_end)
             margin = opening_margin * scene%grid%cell_size
+            load = load + 1
             walls = [walls, make_wall(grid, spec%point, spec%direction, lower, upper, margin, wall_kind_prescribed, &
                                       velocity=spec%velocity * spec%direction, active_from=spec%start_time, &
-                                      active_until=spec%end_time), &
+                                      active_until=spec%end_time, load=load), &
                      make_wall(grid, spec%point, spec%direction, lower, upper, margin, wall_kind_slip, &
-                               active_from=spec%end_time)]
+                               active_from=spec%end_time, load=load)]
             if (spec%start_time > 0.0_rp) &
                walls = [walls, make_wall(grid, spec%point, spec%direction, lower, upper, margin, wall_kind_slip, &
-                                         active_until=spec%start_time)]
+                                         active_until=spec%start_time, load=load)]
          end associate
       end do
    end subroutine build_inlets

@@ -33,6 +33,9 @@ module mpm_solver
    use volume_correction, only: volume_corrector_t, max_shift_in_cells
    use boundary_walls, only: wall_t, build_walls, set_wall_activity, apply_wall_constraints, keep_particles_inside
    use fluid_inflow, only: inlet_t, build_inlets
+   use wall_loads, only: wall_loads_t
+   use fluid_gauges, only: fluid_gauges_t
+   use body_motion, only: body_motion_t
    use world_frame, only: frame_t, place_grid
    use grid_transfer, only: particles_to_grid, update_velocity_and_remap, grid_to_particles
    use run_diagnostics, only: diagnostics_t, compute_diagnostics
@@ -42,7 +45,7 @@ module mpm_solver
    use phase_timers, only: phase_timers_t, phase_particles_to_grid, phase_grid_update, phase_walls, &
                            phase_stabilization, phase_grid_to_particles, phase_constitutive, phase_inflow, &
                            phase_halo, phase_migration, phase_sort, phase_time_step, phase_volume_correction, &
-                           phase_other
+                           phase_loads, phase_other
    implicit none
    private
 
@@ -61,6 +64,9 @@ module mpm_solver
       type(volume_corrector_t) :: volume        !< fluid volume consistency options (none by default)
       type(wall_t), allocatable :: walls(:)
       type(inlet_t), allocatable :: inlets(:)
+      type(wall_loads_t) :: loads               !< impulse of every wall since the last row of loads.csv
+      type(fluid_gauges_t) :: gauges            !< the &gauge sensors (gauges.csv)
+      type(body_motion_t) :: bodies             !< the solid bodies (bodies.csv)
       real(rp) :: time = 0.0_rp, dt = 0.0_rp
       integer(i8) :: step = 0
       integer :: lost_particles = 0             !< local count of particles that left the grid
@@ -123,6 +129,9 @@ contains
       call agree_on_status(status, self%domain%comm)
       if (.not. status%ok) return
       call build_boundaries(self)
+      call self%loads%init(scene)
+      call self%gauges%init(scene, frame, self%gravity)
+      call self%bodies%init(scene, self%materials, frame, self%gravity)
 
       call self%particles%init(scene%grid%dim, size(scene%materials), 1024)
       seed = .true.
@@ -144,6 +153,8 @@ contains
       self%time = 0.0_rp
       self%step = 0
       self%dt = self%stable_time_step()
+      ! the bodies' momentum at t = 0 starts their force series (a restart reads it from the checkpoint)
+      if (seed) call self%bodies%start(self%bodies%measure(self%particles, self%grid%frame, self%domain%comm))
    end subroutine solver_init
 
    !> The walls (with their local nodes) and the inlets (with their feeder walls) of the scene.
@@ -265,6 +276,7 @@ contains
       dt = self%dt
       call self%timers%switch_to(phase_walls)
       call set_wall_activity(self%walls, self%time)
+      call self%loads%begin_step(size(self%walls))
       if (self%volume%shifting) then
          call self%timers%switch_to(phase_volume_correction)
          call self%volume%prepare(self%domain, self%grid, self%walls, self%particles, self%step)
@@ -347,7 +359,9 @@ contains
       end if
 
       call self%timers%switch_to(phase_walls)
-      call keep_particles_inside(self%walls, self%grid, self%particles, self%wall_corrections)
+      call keep_particles_inside(self%walls, self%grid, self%particles, self%wall_corrections, self%loads%step_impulse)
+      call self%timers%switch_to(phase_loads)
+      call self%loads%end_step(self%walls, self%domain%comm, self%domain%nranks)
       call self%timers%switch_to(phase_inflow)
       created = 0
       do i = 1, size(self%inlets)
@@ -414,7 +428,9 @@ contains
             end if
          end do
          call self%timers%switch_to(phase_walls)
-         call apply_wall_constraints(self%walls, dim, v)
+         ! the walls' impulse on the nodes is the load on them (algorithms.md section 9.1); the MUSL re-map
+         ! below applies the walls again to velocities only, which moves no momentum
+         call apply_wall_constraints(self%walls, dim, v, acc(row_mass, :), self%loads%step_impulse)
          call self%timers%switch_to(phase_grid_update)
          dv = v - dv
       end associate

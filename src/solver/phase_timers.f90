@@ -13,15 +13,15 @@ module phase_timers
                                  phase_inflow = 7, phase_halo = 8, phase_migration = 9, phase_sort = 10, &
                                  phase_time_step = 11, phase_health = 12, phase_diagnostics = 13, phase_output = 14, &
                                  phase_checkpoint = 15, phase_rebalance = 16, phase_volume_correction = 17, &
-                                 phase_other = 18
-   integer, parameter, public :: phase_count = 18
+                                 phase_loads = 18, phase_other = 19
+   integer, parameter, public :: phase_count = 19
 
    !> Column names of timing.csv, in the order of the phase numbers.
    character(len=*), parameter, public :: phase_names(phase_count) = [character(len=18) :: &
                                           'particles_to_grid', 'grid_update', 'walls', 'stabilization', &
                                           'grid_to_particles', 'constitutive', 'inflow', 'node_halo', &
                                           'migration', 'sort', 'time_step', 'health_check', 'diagnostics', &
-                                          'output', 'checkpoint', 'rebalance', 'volume_correction', 'other']
+                                          'output', 'checkpoint', 'rebalance', 'volume_correction', 'loads', 'other']
 
    type, public :: phase_timers_t
       real(rp) :: seconds(phase_count) = 0.0_rp   !< accumulated wall time per phase [s]

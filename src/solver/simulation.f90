@@ -16,8 +16,9 @@ module simulation
    use mpm_solver, only: solver_t
    use run_diagnostics, only: diagnostics_t, diagnostics_header, diagnostics_row
    use csv_writer, only: csv_writer_t, keep_rows_until
+   use load_records, only: load_records_t
    use run_summary, only: write_run_summary, write_timing
-   use phase_timers, only: phase_health, phase_diagnostics, phase_output, phase_checkpoint, phase_rebalance, &
+   use phase_timers, only: phase_health, phase_loads, phase_diagnostics, phase_output, phase_checkpoint, phase_rebalance, &
                            phase_other, phase_names
    use progress_reporter, only: progress_reporter_t
    use status_broadcast, only: broadcast_status, agree_on_status
@@ -54,6 +55,7 @@ contains
       type(status_t), intent(inout) :: status
       integer, intent(out) :: stopped_by
       type(csv_writer_t) :: csv
+      type(load_records_t) :: records
       type(progress_reporter_t) :: reporter
       type(diagnostics_t) :: diag
       character(len=:), allocatable :: dir, checkpoint_path
@@ -71,6 +73,12 @@ contains
       density_limits = blow_up_densities(solver)
       call open_diagnostics(solver, progress, csv, status)
       if (.not. status%ok) return
+      call records%open(solver, progress, status)
+      if (.not. status%ok) then
+         call csv%close()
+         call records%close()
+         return
+      end if
 
       ! a restart continues in the checkpoint's layout (read_checkpoint); a new run starts balanced
       if (.not. progress%restarted) call solver%balance_load(status)
@@ -125,6 +133,12 @@ contains
             outcome = 'blew_up'
             exit
          end if
+         ! loads, gauges and bodies: before a checkpoint of this step, which then holds the next interval's start
+         if (records%due(solver)) then
+            call solver%timers%switch_to(phase_loads)
+            call records%write_rows(solver)
+            call solver%timers%switch_to(phase_other)
+         end if
 
          at_output = solver%time >= progress%next_output_time * (1.0_rp - 1.0e-12_rp) .or. &
                      solver%step >= solver%run%max_steps
@@ -172,6 +186,7 @@ contains
       if (status%ok .and. last_checkpoint_step /= solver%step) &
          call write_checkpoint(solver, progress, dir, solver%run%checkpoints_kept, checkpoint_path, status)
       call csv%close()
+      call records%close()
       call solver%timers%switch_to(phase_other)
       if (.not. status%ok .and. outcome == 'finished') outcome = 'failed'
       block

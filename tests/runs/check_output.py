@@ -124,7 +124,7 @@ def check_run(checks, flotsam, scenes, name, ranks, fluid_materials, empty_rank=
 
 PHASES = ["particles_to_grid", "grid_update", "walls", "stabilization", "grid_to_particles", "constitutive",
           "inflow", "node_halo", "migration", "sort", "time_step", "health_check", "diagnostics", "output",
-          "checkpoint", "rebalance", "volume_correction", "other"]
+          "checkpoint", "rebalance", "volume_correction", "loads", "other"]
 
 
 def check_timing(checks, name, directory, smoothed):

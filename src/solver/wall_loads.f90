@@ -1,0 +1,136 @@
+!> Forces and moments the material exerts on the walls, box sides and inlets of a scene (loads.csv;
+!> docs/loads.md, docs/theory.md section 3.2, algorithms.md section 9.1).
+!>
+!> Every step the walls record, per wall and rank, the momentum their constraints gave the material
+!> (boundary_walls: nodal constraint m_i (v^c - v^*), counted once per shared node, and the particle
+!> safeguard m_p (v^c - v)). At the end of the step these are summed per entry of loads.csv (an inlet's
+!> feeder and closing walls are one entry) and over the ranks, and added to the impulse since the last
+!> row. Summing over the ranks every step, in the same order on every rank, makes the accumulated
+!> impulse a global value that a checkpoint stores and a restart continues bit for bit.
+!> A row is the load averaged over the interval since the previous row: F = -J / (t - t_prev),
+!> the impulse divided by the interval's length, so that no impulse is lost between rows.
+module wall_loads
+   use kinds, only: rp, name_len
+   use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_SUM
+   use scene_description, only: scene_t, wall_spec_t
+   use boundary_walls, only: wall_t, impulse_rows, box_side_walls
+   use world_frame, only: frame_t
+   implicit none
+   private
+
+   type, public :: wall_loads_t
+      integer :: dim = 2
+      character(len=name_len), allocatable :: names(:)   !< one entry per wall, box side and inlet
+      real(rp), allocatable :: step_impulse(:, :)        !< (impulse_rows, wall) this rank, this step
+      real(rp), allocatable :: impulse(:, :)             !< (impulse_rows, entry) all ranks, since last row
+      !> time of the last row of loads.csv, gauges.csv and bodies.csv: the start of the interval now
+      !> accumulating (0 at the start of a run; saved in checkpoints)
+      real(rp) :: last_row_time = 0.0_rp
+   contains
+      procedure :: init => loads_init
+      procedure :: begin_step => loads_begin_step
+      procedure :: end_step => loads_end_step
+      procedure :: row_values => loads_row_values
+      procedure :: column_names => loads_column_names
+   end type wall_loads_t
+
+contains
+
+   !> The entries of the scene in loads.csv order: the &wall groups, the &box_walls sides that are walls,
+   !> the &inlet groups (the order of the walls boundary_walls and fluid_inflow build, section 3).
+   subroutine loads_init(self, scene)
+      class(wall_loads_t), intent(inout) :: self
+      type(scene_t), intent(in) :: scene
+      type(wall_spec_t), allocatable :: sides(:)
+      integer :: n_walls, n_inlets
+      self%dim = scene%grid%dim
+      sides = box_side_walls(scene%grid)
+      n_walls = 0
+      if (allocated(scene%walls)) n_walls = size(scene%walls)
+      n_inlets = 0
+      if (allocated(scene%inlets)) n_inlets = size(scene%inlets)
+      allocate (self%names(n_walls + size(sides) + n_inlets))
+      if (n_walls > 0) self%names(1:n_walls) = scene%walls%name
+      if (size(sides) > 0) self%names(n_walls + 1:n_walls + size(sides)) = sides%name
+      if (n_inlets > 0) self%names(n_walls + size(sides) + 1:) = scene%inlets%name
+      allocate (self%impulse(impulse_rows, size(self%names)))
+      self%impulse = 0.0_rp
+   end subroutine loads_init
+
+   !> Clear this step's record of the walls (the walls of the current layout: their number never changes).
+   subroutine loads_begin_step(self, n_walls)
+      class(wall_loads_t), intent(inout) :: self
+      integer, intent(in) :: n_walls
+      if (.not. allocated(self%step_impulse)) allocate (self%step_impulse(impulse_rows, n_walls))
+      if (size(self%step_impulse, 2) /= n_walls) then
+         deallocate (self%step_impulse)
+         allocate (self%step_impulse(impulse_rows, n_walls))
+      end if
+      self%step_impulse = 0.0_rp
+   end subroutine loads_begin_step
+
+   !> Add this step's impulses of all ranks to the impulse since the last row. Collective (one small
+   !> reduction, skipped on one rank and in scenes without walls).
+   subroutine loads_end_step(self, walls, comm, nranks)
+      class(wall_loads_t), intent(inout) :: self
+      type(wall_t), intent(in) :: walls(:)
+      type(MPI_Comm), intent(in) :: comm
+      integer, intent(in) :: nranks
+      real(rp) :: step(impulse_rows, size(self%names))
+      integer :: w
+      if (size(self%names) == 0) return
+      step = 0.0_rp
+      do w = 1, size(walls)
+         if (walls(w)%load > 0) step(:, walls(w)%load) = step(:, walls(w)%load) + self%step_impulse(:, w)
+      end do
+      if (nranks > 1) call MPI_Allreduce(MPI_IN_PLACE, step, size(step), MPI_DOUBLE_PRECISION, MPI_SUM, comm)
+      self%impulse = self%impulse + step
+   end subroutine loads_end_step
+
+   !> The row of loads.csv for the interval of length `interval` that ends now, in the world frame, and
+   !> the impulse cleared for the next interval: per entry the force the material exerts on the wall
+   !> (fx, fy[, fz]) and its moment (2-D mz; 3-D mx, my, mz) [N, N m; per metre of depth in 2-D].
+   function loads_row_values(self, frame, interval) result(values)
+      class(wall_loads_t), intent(inout) :: self
+      type(frame_t), intent(in) :: frame
+      real(rp), intent(in) :: interval
+      real(rp), allocatable :: values(:)
+      integer :: e, at, d
+      d = self%dim
+      allocate (values(size(self%names) * merge(3, 6, d == 2)))
+      at = 0
+      do e = 1, size(self%names)
+         ! the material's force on the wall is minus the impulse the wall gave the material
+         values(at + 1:at + d) = -frame%world_vector(self%impulse(1:d, e)) / interval
+         at = at + d
+         if (d == 2) then
+            values(at + 1) = -self%impulse(6, e) / interval     ! a rotation about z keeps m_z
+            at = at + 1
+         else
+            values(at + 1:at + 3) = -frame%world_vector(self%impulse(4:6, e)) / interval
+            at = at + 3
+         end if
+      end do
+      self%impulse = 0.0_rp
+   end function loads_row_values
+
+   !> Column names of loads.csv after `time`, in the order of row_values.
+   function loads_column_names(self) result(columns)
+      class(wall_loads_t), intent(in) :: self
+      character(len=name_len + 3), allocatable :: columns(:)
+      character(len=*), parameter :: suffixes_2d(3) = ['_fx', '_fy', '_mz']
+      character(len=*), parameter :: suffixes_3d(6) = ['_fx', '_fy', '_fz', '_mx', '_my', '_mz']
+      integer :: e, s, n
+      n = merge(3, 6, self%dim == 2)
+      allocate (columns(n * size(self%names)))
+      do e = 1, size(self%names)
+         do s = 1, n
+            if (self%dim == 2) then
+               columns((e - 1) * n + s) = trim(self%names(e))//suffixes_2d(s)
+            else
+               columns((e - 1) * n + s) = trim(self%names(e))//suffixes_3d(s)
+            end if
+         end do
+      end do
+   end function loads_column_names
+end module wall_loads
