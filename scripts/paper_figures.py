@@ -326,6 +326,70 @@ def figure5(args):
           "Fig. 5: the peak pressure at 30 s follows the fluid depth (rho g h_eq within 15 %)",
           (round(peak[last], 2), round(RHO * G * h_eq[-1] / 1e3, 2)))
 
+    figure5_loads(args, folder)
+
+
+def read_series(folder, name):
+    """A loads.csv / gauges.csv / bodies.csv of a run as {column: array} (pandas.read_csv(path, comment='#')
+    reads it as well; this keeps the script on numpy)."""
+    table = np.genfromtxt(os.path.join(folder, name), delimiter=",", names=True)
+    return {key: table[key] for key in table.dtype.names}
+
+
+def figure5_loads(args, folder):
+    """The loads of the paper's scene (docs/loads.md): the block's trajectory and resultant force
+    (bodies.csv), the walls' forces (loads.csv) and the gauges (gauges.csv). At rest at the end the
+    loads known exactly must come out: the floor carries the weight of water and block, the right wall
+    balances the left wall and the closed opening, the floating block's resultant is its weight."""
+    loads, bodies, gauges = (read_series(folder, f) for f in ("loads.csv", "bodies.csv", "gauges.csv"))
+    block_weight = 300.0 * 0.4 * 0.4 * G
+    water_weight = RHO * 6.0 * G                       # 1 m x 1 m/s x 6 s injected
+    fig, (a, b, c) = plt.subplots(1, 3, figsize=(16, 4.2))
+    a.plot(bodies["time"], bodies["block_x"], label="centroid x [m]")
+    a.plot(bodies["time"], bodies["block_y"], label="centroid y [m]")
+    a.plot(bodies["time"], bodies["block_angle"], label="angle [rad]")
+    a.set_xlabel("t [s]")
+    a.set_title("block (bodies.csv)")
+    a.legend(fontsize=8)
+    b.plot(loads["time"], loads["right_wall_fx"] / 1e3, lw=0.6, label="right wall f_x")
+    b.plot(loads["time"], -(loads["left_wall_fx"] + loads["opening_fx"]) / 1e3, lw=0.6,
+           label="-(left wall + opening) f_x")
+    b.plot(loads["time"], -loads["floor_fy"] / 1e3, lw=0.6, label="-floor f_y")
+    b.axhline((water_weight + block_weight) / 1e3, ls="--", c="k", lw=0.8, label="weight of water and block")
+    b.set_xlabel("t [s]")
+    b.set_ylabel("force [kN/m]")
+    b.set_title("walls (loads.csv, 10 ms means)")
+    b.legend(fontsize=8)
+    c.plot(bodies["time"], bodies["block_fy"], lw=0.6, label="block resultant f_y (fluid + walls)")
+    c.axhline(block_weight, ls="--", c="k", lw=0.8, label="block weight")
+    c.set_ylim(-2 * block_weight, 4 * block_weight)
+    c.set_xlabel("t [s]")
+    c.set_ylabel("force [N/m]")
+    c.set_title("block (bodies.csv)")
+    c.legend(fontsize=8)
+    save(fig, "fig5_loads.png")
+
+    settled = loads["time"] > 20.0
+    floor = -loads["floor_fy"][settled].mean()
+    right = loads["right_wall_fx"][settled].mean()
+    left = -(loads["left_wall_fx"] + loads["opening_fx"])[settled].mean()
+    block = bodies["block_fy"][bodies["time"] > 20.0].mean()
+    summary["fig5_loads"] = {"floor_kN": floor / 1e3, "right_wall_kN": right / 1e3, "left_and_opening_kN": left / 1e3,
+                             "block_fy_N": block, "block_y_30s": bodies["block_y"][-1],
+                             "block_angle_30s": bodies["block_angle"][-1],
+                             "peak_right_wall_kN": loads["right_wall_fx"].max() / 1e3,
+                             "p_right_foot_30s_kPa": gauges["p_right_foot_pressure"][-1] / 1e3,
+                             "level_right_30s": gauges["level_right_level"][-1]}
+    assert_claim(args, abs(floor / (water_weight + block_weight) - 1) <= 0.005,
+                 "loads: the floor carries the weight of water and block over 20-30 s (within 0.5 %)",
+                 (round(floor, 1), water_weight + block_weight))
+    assert_claim(args, abs(right / left - 1) <= 0.01,
+                 "loads: the right wall's force balances the left wall's and the closed opening's over 20-30 s (1 %)",
+                 (round(right, 1), round(left, 1)))
+    assert_claim(args, abs(block / block_weight - 1) <= 0.01,
+                 "loads: the floating block's resultant force is its weight over 20-30 s (1 %)",
+                 (round(block, 2), block_weight))
+
 
 # The options of docs/volume-conservation.md: (label, stabilization, volume_correction or None)
 VOLUME_VARIANTS = [("FOAL1", "FOAL1", None), ("NB", "NB", None), ("FOAL1 + shifting", "FOAL1", "shifting"),

@@ -78,8 +78,8 @@ contains
       call file%write_attribute('dt', solver%dt, status)
       call file%write_attribute('mass_tolerance', solver%mass_tolerance, status)
       call file%write_attribute('next_output_time', progress%next_output_time, status)
-      call write_series_state(solver, file, status)
       call write_particles(solver, file, status)
+      call write_series_state(solver, file, status)      ! after write_particles: it made the group ranks
       call write_outputs(solver, progress, file, status)
       ! last: a file without it was not finished (cannot happen after the rename, but costs nothing)
       call file%write_attribute('complete', 1, status)
@@ -312,7 +312,7 @@ contains
       call file%read_slab('particles/material', slab, material, status)
       call file%read_slab('particles/id', slab, id, status)
       call read_outputs(file, progress, status)
-      call read_series_state(solver, file, status)
+      call read_series_state(solver, file, all_ranks, ranks_written == n_ranks, status)
       if (status%ok .and. n > 0) then
          if (any(material(1:n) < 1 .or. material(1:n) > size(solver%materials))) &
             call status%fail(where//' holds a particle of an unknown material')
@@ -356,33 +356,51 @@ contains
    end subroutine read_checkpoint
 
    !> What the series of loads.csv, gauges.csv and bodies.csv carry from row to row (load_records): the
-   !> last row's time, the wall impulse since then, the bodies' momentum and 2-D angle at that row. With
-   !> them a restart continues the rows bit for bit. Attributes of zero size are not written.
+   !> last row's time, each rank's wall impulse since then (ranks/load_impulse, one column per rank),
+   !> the bodies' momentum and 2-D angle at that row. With them a restart on the same ranks continues
+   !> the rows bit for bit. Data of zero size is not written.
    subroutine write_series_state(solver, file, status)
       type(solver_t), intent(in) :: solver
       type(hdf5_file_t), intent(inout) :: file
       type(status_t), intent(inout) :: status
       call file%write_attribute('last_load_row_time', solver%loads%last_row_time, status)
-      if (size(solver%loads%impulse) > 0) &
-         call file%write_attribute('load_impulse', reshape(solver%loads%impulse, [size(solver%loads%impulse)]), status)
       if (solver%bodies%count() > 0) then
          call file%write_attribute('body_momentum', reshape(solver%bodies%previous_momentum, &
                                                             [size(solver%bodies%previous_momentum)]), status)
          call file%write_attribute('body_angle', solver%bodies%previous_angle, status)
       end if
+      if (size(solver%loads%impulse) > 0) then
+         call file%write_slab('ranks/load_impulse', distributed_slab(solver%domain%comm, 1), &
+                              reshape(solver%loads%impulse, [size(solver%loads%impulse), 1]), status)
+      end if
    end subroutine write_series_state
 
-   subroutine read_series_state(solver, file, status)
+   !> The state write_series_state saved. On the ranks that wrote it each rank takes its own impulse;
+   !> on another number of ranks rank 0 takes their sum (a row sums over the ranks anyway).
+   subroutine read_series_state(solver, file, all_ranks, same_decomposition, status)
       type(solver_t), intent(inout) :: solver
       type(hdf5_file_t), intent(inout) :: file
+      type(slab_t), intent(in) :: all_ranks
+      logical, intent(in) :: same_decomposition
       type(status_t), intent(inout) :: status
-      real(rp), allocatable :: flat(:)
+      real(rp), allocatable :: flat(:), per_rank(:, :)
+      integer :: r
       call file%read_attribute('last_load_row_time', solver%loads%last_row_time, status)
       if (size(solver%loads%impulse) > 0) then
-         allocate (flat(size(solver%loads%impulse)))
-         call file%read_attribute('load_impulse', flat, status)
-         if (status%ok) solver%loads%impulse = reshape(flat, shape(solver%loads%impulse))
-         deallocate (flat)
+         allocate (per_rank(size(solver%loads%impulse), all_ranks%total))
+         call file%read_slab('ranks/load_impulse', all_ranks, per_rank, status)
+         if (status%ok) then
+            if (same_decomposition) then
+               solver%loads%impulse = reshape(per_rank(:, solver%domain%rank + 1), shape(solver%loads%impulse))
+            else
+               solver%loads%impulse = 0.0_rp
+               if (solver%domain%rank == 0) then
+                  do r = 1, size(per_rank, 2)
+                     solver%loads%impulse = solver%loads%impulse + reshape(per_rank(:, r), shape(solver%loads%impulse))
+                  end do
+               end if
+            end if
+         end if
       end if
       if (solver%bodies%count() > 0) then
          allocate (flat(size(solver%bodies%previous_momentum)))

@@ -98,7 +98,7 @@ contains
       interval = solver%time - solver%loads%last_row_time
       if (interval <= 0.0_rp) return
       if (self%used(file_loads)) then
-         values = solver%loads%row_values(solver%grid%frame, interval)
+         values = solver%loads%row_values(solver%grid%frame, interval, solver%domain%comm, solver%domain%nranks)
          if (solver%domain%rank == 0) call self%files(file_loads)%write_row(row_text(solver%time, values))
       end if
       if (self%used(file_gauges)) then

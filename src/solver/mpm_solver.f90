@@ -361,7 +361,7 @@ contains
       call self%timers%switch_to(phase_walls)
       call keep_particles_inside(self%walls, self%grid, self%particles, self%wall_corrections, self%loads%step_impulse)
       call self%timers%switch_to(phase_loads)
-      call self%loads%end_step(self%walls, self%domain%comm, self%domain%nranks)
+      call self%loads%end_step(self%walls)
       call self%timers%switch_to(phase_inflow)
       created = 0
       do i = 1, size(self%inlets)

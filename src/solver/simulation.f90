@@ -157,7 +157,10 @@ contains
             call write_output(solver, progress, status)
             call solver%timers%switch_to(phase_other)
             if (.not. status%ok) exit
-            progress%next_output_time = min(progress%next_output_time + interval, end_time)
+            ! an output forced by max_steps before the output time keeps the schedule: a run continued
+            ! from its checkpoint must still land on the output time it had not reached
+            if (solver%time >= progress%next_output_time * (1.0_rp - 1.0e-12_rp)) &
+               progress%next_output_time = min(progress%next_output_time + interval, end_time)
          end if
 
          checkpoint_due = flags(flag_signal) > 0 .or. flags(flag_wall_checkpoint) > 0

@@ -3,12 +3,11 @@
 !>
 !> Every step the walls record, per wall and rank, the momentum their constraints gave the material
 !> (boundary_walls: nodal constraint m_i (v^c - v^*), counted once per shared node, and the particle
-!> safeguard m_p (v^c - v)). At the end of the step these are summed per entry of loads.csv (an inlet's
-!> feeder and closing walls are one entry) and over the ranks, and added to the impulse since the last
-!> row. Summing over the ranks every step, in the same order on every rank, makes the accumulated
-!> impulse a global value that a checkpoint stores and a restart continues bit for bit.
-!> A row is the load averaged over the interval since the previous row: F = -J / (t - t_prev),
-!> the impulse divided by the interval's length, so that no impulse is lost between rows.
+!> safeguard m_p (v^c - v)). At the end of the step these are added, per entry of loads.csv (an inlet's
+!> feeder and closing walls are one entry), to this rank's impulse since the last row: no communication
+!> per step. A row sums the ranks' impulses (one reduction) and divides by the interval's length,
+!> F = -J / (t - t_prev), so that no impulse is lost between rows. Each rank's impulse is saved in
+!> checkpoints (checkpoint.f90): a restart on the same ranks continues the rows bit for bit.
 module wall_loads
    use kinds, only: rp, name_len
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_SUM
@@ -22,7 +21,7 @@ module wall_loads
       integer :: dim = 2
       character(len=name_len), allocatable :: names(:)   !< one entry per wall, box side and inlet
       real(rp), allocatable :: step_impulse(:, :)        !< (impulse_rows, wall) this rank, this step
-      real(rp), allocatable :: impulse(:, :)             !< (impulse_rows, entry) all ranks, since last row
+      real(rp), allocatable :: impulse(:, :)             !< (impulse_rows, entry) this rank, since last row
       !> time of the last row of loads.csv, gauges.csv and bodies.csv: the start of the interval now
       !> accumulating (0 at the start of a run; saved in checkpoints)
       real(rp) :: last_row_time = 0.0_rp
@@ -69,45 +68,44 @@ contains
       self%step_impulse = 0.0_rp
    end subroutine loads_begin_step
 
-   !> Add this step's impulses of all ranks to the impulse since the last row. Collective (one small
-   !> reduction, skipped on one rank and in scenes without walls).
-   subroutine loads_end_step(self, walls, comm, nranks)
+   !> Add this step's impulses to this rank's impulse since the last row (per loads.csv entry).
+   subroutine loads_end_step(self, walls)
       class(wall_loads_t), intent(inout) :: self
       type(wall_t), intent(in) :: walls(:)
-      type(MPI_Comm), intent(in) :: comm
-      integer, intent(in) :: nranks
-      real(rp) :: step(impulse_rows, size(self%names))
       integer :: w
-      if (size(self%names) == 0) return
-      step = 0.0_rp
       do w = 1, size(walls)
-         if (walls(w)%load > 0) step(:, walls(w)%load) = step(:, walls(w)%load) + self%step_impulse(:, w)
+         if (walls(w)%load > 0) self%impulse(:, walls(w)%load) = self%impulse(:, walls(w)%load) + self%step_impulse(:, w)
       end do
-      if (nranks > 1) call MPI_Allreduce(MPI_IN_PLACE, step, size(step), MPI_DOUBLE_PRECISION, MPI_SUM, comm)
-      self%impulse = self%impulse + step
    end subroutine loads_end_step
 
    !> The row of loads.csv for the interval of length `interval` that ends now, in the world frame, and
    !> the impulse cleared for the next interval: per entry the force the material exerts on the wall
    !> (fx, fy[, fz]) and its moment (2-D mz; 3-D mx, my, mz) [N, N m; per metre of depth in 2-D].
-   function loads_row_values(self, frame, interval) result(values)
+   !> Collective (one small reduction; none on one rank).
+   function loads_row_values(self, frame, interval, comm, nranks) result(values)
       class(wall_loads_t), intent(inout) :: self
       type(frame_t), intent(in) :: frame
       real(rp), intent(in) :: interval
+      type(MPI_Comm), intent(in) :: comm
+      integer, intent(in) :: nranks
       real(rp), allocatable :: values(:)
+      real(rp) :: total(impulse_rows, size(self%names))
       integer :: e, at, d
       d = self%dim
+      total = self%impulse
+      if (nranks > 1 .and. size(total) > 0) &
+         call MPI_Allreduce(MPI_IN_PLACE, total, size(total), MPI_DOUBLE_PRECISION, MPI_SUM, comm)
       allocate (values(size(self%names) * merge(3, 6, d == 2)))
       at = 0
       do e = 1, size(self%names)
          ! the material's force on the wall is minus the impulse the wall gave the material
-         values(at + 1:at + d) = -frame%world_vector(self%impulse(1:d, e)) / interval
+         values(at + 1:at + d) = -frame%world_vector(total(1:d, e)) / interval
          at = at + d
          if (d == 2) then
-            values(at + 1) = -self%impulse(6, e) / interval     ! a rotation about z keeps m_z
+            values(at + 1) = -total(6, e) / interval     ! a rotation about z keeps m_z
             at = at + 1
          else
-            values(at + 1:at + 3) = -frame%world_vector(self%impulse(4:6, e)) / interval
+            values(at + 1:at + 3) = -frame%world_vector(total(4:6, e)) / interval
             at = at + 3
          end if
       end do

@@ -50,7 +50,7 @@ contains
       do step = 1, steps
          call solver%advance()
       end do
-      mean_row = solver%loads%row_values(solver%grid%frame, solver%time - start)
+      mean_row = solver%loads%row_values(solver%grid%frame, solver%time - start, solver%domain%comm, solver%domain%nranks)
    end subroutine settled_tank
 
    subroutine test_hydrostatic_wall_loads_2d(comm)
@@ -123,7 +123,7 @@ contains
       end do
       after = total_momentum(solver)
       ! row values are the material's force on each wall: the walls gave -row * interval
-      row = solver%loads%row_values(solver%grid%frame, 1.0_rp)
+      row = solver%loads%row_values(solver%grid%frame, 1.0_rp, solver%domain%comm, solver%domain%nranks)
       walls = 0.0_rp
       do e = 1, size(row) / 3
          walls = walls - row(3 * e - 2:3 * e - 1)
