@@ -32,7 +32,7 @@ program flotsam
    logical :: overwrite
    integer :: rank, exit_code, stopped_by
 
-   call prefer_romio()     ! before MPI_Init: see src/parallel/mpi_io_choice.f90
+   call prefer_romio()     ! before MPI_Init: see src/domain/mpi_io_choice.f90
    call MPI_Init()
    call MPI_Comm_rank(MPI_COMM_WORLD, rank)
    call parse_command_line(scene_path, overrides, overwrite, restart_path, exit_code)

@@ -44,7 +44,7 @@ program flotsam_bench
    real(rp) :: t0, t1, rss_before, rss_after, cpu0, cpu1, cpu
    integer(i8) :: peak, nodes
 
-   call prefer_romio()     ! before MPI_Init: see src/parallel/mpi_io_choice.f90
+   call prefer_romio()     ! before MPI_Init: see src/domain/mpi_io_choice.f90
    call MPI_Init()
    call MPI_Comm_rank(MPI_COMM_WORLD, rank)
    call MPI_Comm_size(MPI_COMM_WORLD, n_ranks)

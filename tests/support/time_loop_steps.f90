@@ -1,4 +1,4 @@
-!> Steps of a solver as the time loop takes them (src/solver/simulation.f90), without output: balanced
+!> Steps of a solver as the time loop takes them (src/driver/simulation.f90), without output: balanced
 !> at the start and every rebalance_interval steps. For the tests that compare whole runs.
 module time_loop_steps
    use kinds, only: i8

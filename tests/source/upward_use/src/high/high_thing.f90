@@ -1,0 +1,5 @@
+!> The layer above low.
+module high_thing
+   implicit none
+   integer, parameter :: high_value = 1
+end module high_thing
