@@ -30,6 +30,7 @@ module namelist_scan
       type(namelist_item_t), allocatable :: items(:)
    contains
       procedure :: assigns => group_assigns
+      procedure :: text => group_text
    end type namelist_group_t
 
    !> All groups of a file, in file order.
@@ -64,6 +65,19 @@ contains
          text = self%value
       end if
    end function item_text
+
+   !> The group as one line `&name item, item, /` (comments removed), as a namelist read of an
+   !> internal file takes it.
+   function group_text(self) result(text)
+      class(namelist_group_t), intent(in) :: self
+      character(len=:), allocatable :: text
+      integer :: i
+      text = '&'//self%name
+      do i = 1, size(self%items)
+         text = text//' '//self%items(i)%text()//','
+      end do
+      text = text//' /'
+   end function group_text
 
    !> Does this group assign variable `name` (whole or in part)?
    logical function group_assigns(self, name) result(assigns)

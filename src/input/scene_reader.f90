@@ -6,7 +6,6 @@
 !> (which start from the scene's current values), the repeated groups, the checks that the base file
 !> gives every required variable, and finally `validate_scene` / `resolve_scene` on the whole scene.
 module scene_reader
-   use, intrinsic :: iso_fortran_env, only: iostat_end
    use mpi_f08, only: MPI_Comm, MPI_Comm_rank
    use kinds, only: rp, i8, path_len
    use error_status, only: status_t
@@ -251,21 +250,17 @@ contains
       if (.not. status%ok) return
       call check_group_counts(file, status)
       if (.not. status%ok) return
-      call read_singleton_groups(unit, file, scene, status)
+      call read_singleton_groups(file, scene, status)
       if (.not. status%ok) return
       allocate (probe%materials(1), probe%bodies(1), probe%walls(1), probe%inlets(1), probe%gauges(1))
       do g = 1, size(file%groups)
          group = file%groups(g)%name
          if (.not. any(repeated_groups == group)) cycle
          k = count_before(file, g) + 1
-         ! the group again as text, so that it can be read into each entry it selects
-         text = '&'//group
-         do j = 1, size(file%groups(g)%items)
-            text = text//' '//file%groups(g)%items(j)%text()//','
-         end do
-         text = text//' /'
+         ! the group as text, so that it can be read into each entry it selects
+         text = file%groups(g)%text()
          message = ''
-         call read_group(group, probe, 1, ios, message, text=text)
+         call read_group(group, probe, 1, ios, message, text)
          if (ios /= 0) then
             call report_read_error(file, group, k, message, status)
             return
@@ -280,7 +275,7 @@ contains
             if (len(chosen) > 0) then
                if (selected_value(group, scene, j) /= chosen) cycle
             end if
-            call read_group(group, scene, j, ios, message, text=text)
+            call read_group(group, scene, j, ios, message, text)
             selected = selected + 1
          end do
          if (selected == 0) then
@@ -411,9 +406,9 @@ contains
             return
          end if
       end do
-      call read_singleton_groups(unit, file, scene, status)
+      call read_singleton_groups(file, scene, status)
       if (.not. status%ok) return
-      call read_repeated_groups(unit, file, scene, status)
+      call read_repeated_groups(file, scene, status)
       if (.not. status%ok) return
       call check_required_variables(file, scene, status)
    end subroutine read_base_file
@@ -437,19 +432,18 @@ contains
 
    !> Read every singleton group present in the file. Each read starts from the values the scene
    !> already holds, so a second file could override some of them.
-   subroutine read_singleton_groups(unit, file, scene, status)
-      integer, intent(in) :: unit
+   subroutine read_singleton_groups(file, scene, status)
       type(namelist_file_t), intent(in) :: file
       type(scene_t), intent(inout) :: scene
       type(status_t), intent(inout) :: status
       character(len=512) :: message
-      integer :: g, ios
+      integer :: g, found, ios
 
       do g = 1, size(singleton_groups)
-         if (file%count(singleton_groups(g)) == 0) cycle
-         rewind (unit)
+         found = file%find(trim(singleton_groups(g)), 1)
+         if (found == 0) cycle
          message = ''
-         call read_group(trim(singleton_groups(g)), scene, 1, ios, message, unit=unit)
+         call read_group(trim(singleton_groups(g)), scene, 1, ios, message, file%groups(found)%text())
          if (ios /= 0) then
             call report_read_error(file, trim(singleton_groups(g)), 1, message, status)
             return
@@ -458,8 +452,7 @@ contains
    end subroutine read_singleton_groups
 
    !> Read every occurrence of the repeated groups, in file order, each from the defaults.
-   subroutine read_repeated_groups(unit, file, scene, status)
-      integer, intent(in) :: unit
+   subroutine read_repeated_groups(file, scene, status)
       type(namelist_file_t), intent(in) :: file
       type(scene_t), intent(inout) :: scene
       type(status_t), intent(inout) :: status
@@ -471,32 +464,24 @@ contains
       type(gauge_spec_t) :: default_gauge
       character(len=512) :: message
       character(len=:), allocatable :: group
-      integer :: g, k, n, ios
+      integer :: g, k, ios
 
       allocate (scene%materials(file%count('material')), scene%bodies(file%count('body')), &
                 scene%walls(file%count('wall')), scene%inlets(file%count('inlet')), scene%gauges(file%count('gauge')))
       allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1), one%gauges(1))
       do g = 1, size(repeated_groups)
          group = trim(repeated_groups(g))
-         n = file%count(group)
-         rewind (unit)
-         k = 0
-         do
+         do k = 1, file%count(group)
             one%materials(1) = default_material
             one%bodies(1) = default_body
             one%walls(1) = default_wall
             one%inlets(1) = default_inlet
             one%gauges(1) = default_gauge
             message = ''
-            call read_group(group, one, 1, ios, message, unit=unit)
-            ! gfortran can also end a read that failed inside a group with iostat_end (`hydrostatic = 'yes'`).
-            if (ios == iostat_end .and. k >= n) exit
-            k = k + 1
+            call read_group(group, one, 1, ios, message, file%groups(file%find(group, k))%text())
             if (ios /= 0) then
                call report_read_error(file, group, k, message, status)
                return
-            else if (k > n) then
-               exit
             end if
             select case (group)
             case ('material')
@@ -511,12 +496,6 @@ contains
                scene%gauges(k) = one%gauges(1)
             end select
          end do
-         if (k /= n) then
-            ! Only a group start the scan did not see as one (e.g. inside a string) can cause this.
-            call status%fail(file%path//': the namelist reader found '//int_text(k)//' groups &'//group//' but the file has '// &
-                             int_text(n)//'; is &'//group//' written inside a string or after a comment?')
-            return
-         end if
       end do
    end subroutine read_repeated_groups
 
@@ -621,7 +600,7 @@ contains
                return
             end if
             item_message = ''
-            call read_group(group, one, 1, ios, item_message, text='&'//group//' '//items(i)%text()//' /')
+            call read_group(group, one, 1, ios, item_message, '&'//group//' '//items(i)%text()//' /')
             if (ios == 0) cycle
             v = find_variable(group, items(i)%name)
             if (ios == value_too_long) then
@@ -693,59 +672,75 @@ contains
       end select
    end function expected_value
 
-   !> Read group `group` into `scene` (into entry `k` of a repeated group) from `unit`, or from the
-   !> internal file `text` when it is present.
-   subroutine read_group(group, scene, k, ios, message, unit, text)
+   !> Read group `group` into `scene` (into entry `k` of a repeated group) from `text`, the group as
+   !> `&group ... /` (namelist_group_t%text: the scan's items, so that a file, an override and a single
+   !> item for an error report are read the same way).
+   !> Each reader below copies the current values into local variables named like the namelist's
+   !> variables (a namelist group can only name variables), reads, and copies them back: that shape
+   !> repeats because the language asks for it, the checks and conversions are shared (take_text).
+   subroutine read_group(group, scene, k, ios, message, text)
       character(len=*), intent(in) :: group
       type(scene_t), intent(inout) :: scene
       integer, intent(in) :: k
       integer, intent(out) :: ios
       character(len=*), intent(inout) :: message
-      integer, intent(in), optional :: unit
-      character(len=*), intent(in), optional :: text
+      character(len=*), intent(in) :: text
       select case (group)
       case ('run')
-         call read_run_group(scene%run, ios, message, unit, text)
+         call read_run_group(scene%run, ios, message, text)
       case ('grid')
-         call read_grid_group(scene%grid, ios, message, unit, text)
+         call read_grid_group(scene%grid, ios, message, text)
       case ('box_walls')
-         call read_box_walls_group(scene%grid, ios, message, unit, text)
+         call read_box_walls_group(scene%grid, ios, message, text)
       case ('gravity')
-         call read_gravity_group(scene%gravity, ios, message, unit, text)
+         call read_gravity_group(scene%gravity, ios, message, text)
       case ('material')
-         call read_material_group(scene%materials(k), ios, message, unit, text)
+         call read_material_group(scene%materials(k), ios, message, text)
       case ('body')
-         call read_body_group(scene%bodies(k), ios, message, unit, text)
+         call read_body_group(scene%bodies(k), ios, message, text)
       case ('wall')
-         call read_wall_group(scene%walls(k), ios, message, unit, text)
+         call read_wall_group(scene%walls(k), ios, message, text)
       case ('inlet')
-         call read_inlet_group(scene%inlets(k), ios, message, unit, text)
+         call read_inlet_group(scene%inlets(k), ios, message, text)
       case ('gauge')
-         call read_gauge_group(scene%gauges(k), ios, message, unit, text)
+         call read_gauge_group(scene%gauges(k), ios, message, text)
       case default
          ios = value_too_long
          message = 'no namelist group &'//group
       end select
    end subroutine read_group
 
-   !> ios = value_too_long and a message if string `value` does not fit in `limit` characters.
-   subroutine check_length(variable, value, limit, ios, message)
+   !> After a successful read, store the string `value` of namelist variable `variable` in `target`,
+   !> folded to lower or upper case (adjusted left) when `fold` says so; a value longer than `target`
+   !> sets ios = value_too_long and a message naming the variable instead.
+   subroutine take_text(variable, value, target, ios, message, fold)
       character(len=*), intent(in) :: variable, value
-      integer, intent(in) :: limit
+      character(len=*), intent(inout) :: target
       integer, intent(inout) :: ios
       character(len=*), intent(inout) :: message
-      if (ios /= 0 .or. len_trim(value) <= limit) return
-      ios = value_too_long
-      message = 'variable '//variable//' must be at most '//int_text(limit)//' characters long, got '// &
-                int_text(len_trim(value))
-   end subroutine check_length
+      character(len=*), intent(in), optional :: fold
+      if (ios /= 0) return
+      if (len_trim(value) > len(target)) then
+         ios = value_too_long
+         message = 'variable '//variable//' must be at most '//int_text(len(target))//' characters long, got '// &
+                   int_text(len_trim(value))
+         return
+      end if
+      target = value
+      if (.not. present(fold)) return
+      select case (fold)
+      case ('lower')
+         target = lower_case(adjustl(value))
+      case ('upper')
+         target = upper_case(adjustl(value))
+      end select
+   end subroutine take_text
 
-   subroutine read_run_group(control, ios, message, unit, text)
+   subroutine read_run_group(control, ios, message, text)
       type(run_control_t), intent(inout) :: control
       integer, intent(out) :: ios
       character(len=*), intent(inout) :: message
-      integer, intent(in), optional :: unit
-      character(len=*), intent(in), optional :: text
+      character(len=*), intent(in) :: text
       real(rp) :: end_time, cfl, dt, output_interval, flip_fraction, theta, progress_interval, floor_size, &
                   checkpoint_interval_wall, speed_limit, rebalance_threshold, load_interval
       character(len=text_len) :: output_dir, update_scheme
@@ -778,21 +773,15 @@ contains
       rebalance_threshold = control%rebalance_threshold
       rebalance_interval = control%rebalance_interval
       load_interval = control%load_interval
-      if (present(text)) then
-         read (text, nml=run, iostat=ios, iomsg=message)
-      else
-         read (unit, nml=run, iostat=ios, iomsg=message)
-      end if
-      call check_length('output_dir', output_dir, len(control%output_dir), ios, message)
-      call check_length('update_scheme', update_scheme, len(control%update_scheme), ios, message)
+      read (text, nml=run, iostat=ios, iomsg=message)
+      call take_text('output_dir', output_dir, control%output_dir, ios, message)
+      call take_text('update_scheme', update_scheme, control%update_scheme, ios, message, fold='upper')
       if (ios /= 0) return
       control%end_time = end_time
       control%cfl = cfl
       control%fixed_dt = dt
       control%output_interval = output_interval
-      control%output_dir = output_dir(1:len(control%output_dir))
       control%overwrite = overwrite
-      control%update_scheme = upper_case(adjustl(update_scheme))
       control%flip_fraction = flip_fraction
       control%theta = theta
       control%max_steps = max_steps
@@ -809,12 +798,11 @@ contains
       control%load_interval = load_interval
    end subroutine read_run_group
 
-   subroutine read_grid_group(spec, ios, message, unit, text)
+   subroutine read_grid_group(spec, ios, message, text)
       type(grid_spec_t), intent(inout) :: spec
       integer, intent(out) :: ios
       character(len=*), intent(inout) :: message
-      integer, intent(in), optional :: unit
-      character(len=*), intent(in), optional :: text
+      character(len=*), intent(in) :: text
       integer :: dim
       real(rp) :: cell_size, origin(3), extent(3), rotation
       namelist /grid/ dim, cell_size, origin, extent, rotation
@@ -824,11 +812,7 @@ contains
       origin = spec%origin
       extent = spec%extent
       rotation = spec%rotation
-      if (present(text)) then
-         read (text, nml=grid, iostat=ios, iomsg=message)
-      else
-         read (unit, nml=grid, iostat=ios, iomsg=message)
-      end if
+      read (text, nml=grid, iostat=ios, iomsg=message)
       if (ios /= 0) return
       spec%dim = dim
       spec%cell_size = cell_size
@@ -837,14 +821,17 @@ contains
       spec%rotation = rotation
    end subroutine read_grid_group
 
-   subroutine read_box_walls_group(spec, ios, message, unit, text)
+   subroutine read_box_walls_group(spec, ios, message, text)
       type(grid_spec_t), intent(inout) :: spec
       integer, intent(out) :: ios
       character(len=*), intent(inout) :: message
-      integer, intent(in), optional :: unit
-      character(len=*), intent(in), optional :: text
+      character(len=*), intent(in) :: text
       character(len=text_len) :: x_min, x_max, y_min, y_max, z_min, z_max
       character(len=text_len) :: x_min_name, x_max_name, y_min_name, y_max_name, z_min_name, z_max_name
+      character(len=text_len) :: sides(2, 3), names(2, 3)
+      character(len=*), parameter :: side_variables(2, 3) = reshape([character(len=5) :: 'x_min', 'x_max', &
+                                                                     'y_min', 'y_max', 'z_min', 'z_max'], [2, 3])
+      integer :: s, d
       namelist /box_walls/ x_min, x_max, y_min, y_max, z_min, z_max, &
          x_min_name, x_max_name, y_min_name, y_max_name, z_min_name, z_max_name
 
@@ -860,63 +847,41 @@ contains
       y_max_name = spec%wall_name(2, 2)
       z_min_name = spec%wall_name(1, 3)
       z_max_name = spec%wall_name(2, 3)
-      if (present(text)) then
-         read (text, nml=box_walls, iostat=ios, iomsg=message)
-      else
-         read (unit, nml=box_walls, iostat=ios, iomsg=message)
-      end if
-      call check_length('x_min', x_min, len(spec%wall), ios, message)
-      call check_length('x_max', x_max, len(spec%wall), ios, message)
-      call check_length('y_min', y_min, len(spec%wall), ios, message)
-      call check_length('y_max', y_max, len(spec%wall), ios, message)
-      call check_length('z_min', z_min, len(spec%wall), ios, message)
-      call check_length('z_max', z_max, len(spec%wall), ios, message)
-      call check_length('x_min_name', x_min_name, len(spec%wall_name), ios, message)
-      call check_length('x_max_name', x_max_name, len(spec%wall_name), ios, message)
-      call check_length('y_min_name', y_min_name, len(spec%wall_name), ios, message)
-      call check_length('y_max_name', y_max_name, len(spec%wall_name), ios, message)
-      call check_length('z_min_name', z_min_name, len(spec%wall_name), ios, message)
-      call check_length('z_max_name', z_max_name, len(spec%wall_name), ios, message)
-      if (ios /= 0) return
-      spec%wall(1, 1) = lower_case(adjustl(x_min))
-      spec%wall(2, 1) = lower_case(adjustl(x_max))
-      spec%wall(1, 2) = lower_case(adjustl(y_min))
-      spec%wall(2, 2) = lower_case(adjustl(y_max))
-      spec%wall(1, 3) = lower_case(adjustl(z_min))
-      spec%wall(2, 3) = lower_case(adjustl(z_max))
-      spec%wall_name(1, 1) = x_min_name(1:len(spec%wall_name))
-      spec%wall_name(2, 1) = x_max_name(1:len(spec%wall_name))
-      spec%wall_name(1, 2) = y_min_name(1:len(spec%wall_name))
-      spec%wall_name(2, 2) = y_max_name(1:len(spec%wall_name))
-      spec%wall_name(1, 3) = z_min_name(1:len(spec%wall_name))
-      spec%wall_name(2, 3) = z_max_name(1:len(spec%wall_name))
+      read (text, nml=box_walls, iostat=ios, iomsg=message)
+      sides = reshape([character(len=text_len) :: x_min, x_max, y_min, y_max, z_min, z_max], [2, 3])
+      names = reshape([character(len=text_len) :: x_min_name, x_max_name, y_min_name, y_max_name, z_min_name, &
+                       z_max_name], [2, 3])
+      do d = 1, 3
+         do s = 1, 2
+            call take_text(side_variables(s, d), sides(s, d), spec%wall(s, d), ios, message, fold='lower')
+         end do
+      end do
+      do d = 1, 3
+         do s = 1, 2
+            call take_text(side_variables(s, d)//'_name', names(s, d), spec%wall_name(s, d), ios, message)
+         end do
+      end do
    end subroutine read_box_walls_group
 
-   subroutine read_gravity_group(vector, ios, message, unit, text)
+   subroutine read_gravity_group(vector, ios, message, text)
       real(rp), intent(inout) :: vector(3)
       integer, intent(out) :: ios
       character(len=*), intent(inout) :: message
-      integer, intent(in), optional :: unit
-      character(len=*), intent(in), optional :: text
+      character(len=*), intent(in) :: text
       real(rp) :: acceleration(3)
       namelist /gravity/ acceleration
 
       acceleration = vector
-      if (present(text)) then
-         read (text, nml=gravity, iostat=ios, iomsg=message)
-      else
-         read (unit, nml=gravity, iostat=ios, iomsg=message)
-      end if
+      read (text, nml=gravity, iostat=ios, iomsg=message)
       if (ios /= 0) return
       vector = acceleration
    end subroutine read_gravity_group
 
-   subroutine read_material_group(spec, ios, message, unit, text)
+   subroutine read_material_group(spec, ios, message, text)
       type(material_spec_t), intent(inout) :: spec
       integer, intent(out) :: ios
       character(len=*), intent(inout) :: message
-      integer, intent(in), optional :: unit
-      character(len=*), intent(in), optional :: text
+      character(len=*), intent(in) :: text
       character(len=text_len) :: name, model, stabilization, oscillation_rule, smoothed_variables, volume_correction
       real(rp) :: density, bulk_modulus, viscosity, youngs_modulus, poisson_ratio, gamma_max, shifting_coefficient, &
                   eos_relaxation_rate
@@ -941,42 +906,33 @@ contains
       volume_correction = spec%volume_correction
       shifting_coefficient = spec%shifting_coefficient
       eos_relaxation_rate = spec%eos_relaxation_rate
-      if (present(text)) then
-         read (text, nml=material, iostat=ios, iomsg=message)
-      else
-         read (unit, nml=material, iostat=ios, iomsg=message)
-      end if
-      call check_length('name', name, len(spec%name), ios, message)
-      call check_length('model', model, len(spec%model), ios, message)
-      call check_length('stabilization', stabilization, len(spec%stabilization), ios, message)
-      call check_length('oscillation_rule', oscillation_rule, len(spec%oscillation_rule), ios, message)
-      call check_length('smoothed_variables', smoothed_variables, len(spec%smoothed_variables), ios, message)
-      call check_length('volume_correction', volume_correction, len(spec%volume_correction), ios, message)
+      read (text, nml=material, iostat=ios, iomsg=message)
+      call take_text('name', name, spec%name, ios, message)
+      call take_text('model', model, spec%model, ios, message, fold='lower')
+      call take_text('stabilization', stabilization, spec%stabilization, ios, message)
+      call take_text('oscillation_rule', oscillation_rule, spec%oscillation_rule, ios, message)
+      call take_text('smoothed_variables', smoothed_variables, spec%smoothed_variables, ios, message, fold='lower')
+      call take_text('volume_correction', volume_correction, spec%volume_correction, ios, message, fold='lower')
       if (ios /= 0) return
-      spec%name = name(1:len(spec%name))
-      spec%model = lower_case(adjustl(model))
       spec%density = density
       spec%bulk_modulus = bulk_modulus
       spec%viscosity = viscosity
       spec%youngs_modulus = youngs_modulus
       spec%poisson_ratio = poisson_ratio
-      spec%stabilization = canonical_keyword(adjustl(stabilization), stabilization_keywords)
+      spec%stabilization = canonical_keyword(adjustl(spec%stabilization), stabilization_keywords)
       spec%volumetric_only = volumetric_only
-      spec%oscillation_rule = canonical_keyword(adjustl(oscillation_rule), oscillation_rule_keywords)
+      spec%oscillation_rule = canonical_keyword(adjustl(spec%oscillation_rule), oscillation_rule_keywords)
       spec%gamma_max = gamma_max
-      spec%smoothed_variables = lower_case(adjustl(smoothed_variables))
       spec%cell_averaging = cell_averaging
-      spec%volume_correction = lower_case(adjustl(volume_correction))
       spec%shifting_coefficient = shifting_coefficient
       spec%eos_relaxation_rate = eos_relaxation_rate
    end subroutine read_material_group
 
-   subroutine read_body_group(spec, ios, message, unit, text)
+   subroutine read_body_group(spec, ios, message, text)
       type(body_spec_t), intent(inout) :: spec
       integer, intent(out) :: ios
       character(len=*), intent(inout) :: message
-      integer, intent(in), optional :: unit
-      character(len=*), intent(in), optional :: text
+      character(len=*), intent(in) :: text
       character(len=text_len) :: name, material
       real(rp) :: lower(3), upper(3), velocity(3), free_surface_level
       integer :: particles_per_cell
@@ -991,16 +947,10 @@ contains
       velocity = spec%velocity
       hydrostatic = spec%hydrostatic
       free_surface_level = spec%free_surface_level
-      if (present(text)) then
-         read (text, nml=body, iostat=ios, iomsg=message)
-      else
-         read (unit, nml=body, iostat=ios, iomsg=message)
-      end if
-      call check_length('name', name, len(spec%name), ios, message)
-      call check_length('material', material, len(spec%material), ios, message)
+      read (text, nml=body, iostat=ios, iomsg=message)
+      call take_text('name', name, spec%name, ios, message)
+      call take_text('material', material, spec%material, ios, message)
       if (ios /= 0) return
-      spec%name = name(1:len(spec%name))
-      spec%material = material(1:len(spec%material))
       spec%lower = lower
       spec%upper = upper
       spec%particles_per_cell = particles_per_cell
@@ -1009,12 +959,11 @@ contains
       spec%free_surface_level = free_surface_level
    end subroutine read_body_group
 
-   subroutine read_wall_group(spec, ios, message, unit, text)
+   subroutine read_wall_group(spec, ios, message, text)
       type(wall_spec_t), intent(inout) :: spec
       integer, intent(out) :: ios
       character(len=*), intent(inout) :: message
-      integer, intent(in), optional :: unit
-      character(len=*), intent(in), optional :: text
+      character(len=*), intent(in) :: text
       character(len=text_len) :: condition, name
       real(rp) :: point(3), normal(3), lower(3), upper(3), moment_point(3)
       namelist /wall/ point, normal, lower, upper, condition, name, moment_point
@@ -1026,29 +975,22 @@ contains
       condition = spec%condition
       name = spec%name
       moment_point = spec%moment_point
-      if (present(text)) then
-         read (text, nml=wall, iostat=ios, iomsg=message)
-      else
-         read (unit, nml=wall, iostat=ios, iomsg=message)
-      end if
-      call check_length('condition', condition, len(spec%condition), ios, message)
-      call check_length('name', name, len(spec%name), ios, message)
+      read (text, nml=wall, iostat=ios, iomsg=message)
+      call take_text('condition', condition, spec%condition, ios, message, fold='lower')
+      call take_text('name', name, spec%name, ios, message)
       if (ios /= 0) return
       spec%point = point
       spec%normal = normal
       spec%lower = lower
       spec%upper = upper
-      spec%condition = lower_case(adjustl(condition))
-      spec%name = name(1:len(spec%name))
       spec%moment_point = moment_point
    end subroutine read_wall_group
 
-   subroutine read_inlet_group(spec, ios, message, unit, text)
+   subroutine read_inlet_group(spec, ios, message, text)
       type(inlet_spec_t), intent(inout) :: spec
       integer, intent(out) :: ios
       character(len=*), intent(inout) :: message
-      integer, intent(in), optional :: unit
-      character(len=*), intent(in), optional :: text
+      character(len=*), intent(in) :: text
       character(len=text_len) :: name, material
       real(rp) :: point(3), direction(3), height, width, velocity, start_time, end_time
       integer :: particles_per_cell
@@ -1067,16 +1009,10 @@ contains
       end_time = spec%end_time
       particles_per_cell = spec%particles_per_cell
       hydrostatic = spec%hydrostatic
-      if (present(text)) then
-         read (text, nml=inlet, iostat=ios, iomsg=message)
-      else
-         read (unit, nml=inlet, iostat=ios, iomsg=message)
-      end if
-      call check_length('name', name, len(spec%name), ios, message)
-      call check_length('material', material, len(spec%material), ios, message)
+      read (text, nml=inlet, iostat=ios, iomsg=message)
+      call take_text('name', name, spec%name, ios, message)
+      call take_text('material', material, spec%material, ios, message)
       if (ios /= 0) return
-      spec%name = name(1:len(spec%name))
-      spec%material = material(1:len(spec%material))
       spec%point = point
       spec%direction = direction
       spec%height = height
@@ -1088,12 +1024,11 @@ contains
       spec%hydrostatic = hydrostatic
    end subroutine read_inlet_group
 
-   subroutine read_gauge_group(spec, ios, message, unit, text)
+   subroutine read_gauge_group(spec, ios, message, text)
       type(gauge_spec_t), intent(inout) :: spec
       integer, intent(out) :: ios
       character(len=*), intent(inout) :: message
-      integer, intent(in), optional :: unit
-      character(len=*), intent(in), optional :: text
+      character(len=*), intent(in) :: text
       character(len=text_len) :: name, kind
       real(rp) :: point(3), radius
       namelist /gauge/ name, kind, point, radius
@@ -1102,16 +1037,10 @@ contains
       kind = spec%kind
       point = spec%point
       radius = spec%radius
-      if (present(text)) then
-         read (text, nml=gauge, iostat=ios, iomsg=message)
-      else
-         read (unit, nml=gauge, iostat=ios, iomsg=message)
-      end if
-      call check_length('name', name, len(spec%name), ios, message)
-      call check_length('kind', kind, len(spec%kind), ios, message)
+      read (text, nml=gauge, iostat=ios, iomsg=message)
+      call take_text('name', name, spec%name, ios, message)
+      call take_text('kind', kind, spec%kind, ios, message, fold='lower')
       if (ios /= 0) return
-      spec%name = name(1:len(spec%name))
-      spec%kind = lower_case(adjustl(kind))
       spec%point = point
       spec%radius = radius
    end subroutine read_gauge_group
