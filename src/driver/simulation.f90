@@ -24,7 +24,7 @@ module simulation
    use status_broadcast, only: broadcast_status, agree_on_status
    use health_check, only: particles_healthy, describe_unhealthy_particle
    use termination_signals, only: install_termination_handlers, received_termination_signal, signal_name
-   use run_progress, only: run_progress_t
+   use run_progress, only: run_progress_t, scheduled_output_time, output_index_of
    use xdmf_writer, only: output_entry_t, write_particles_xdmf, write_grid_xdmf
    use field_output, only: write_fields, particle_xdmf_attributes, grid_xdmf_attributes
    use checkpoint, only: write_checkpoint
@@ -62,7 +62,7 @@ contains
       real(rp) :: end_time, interval, speed_limit, last_checkpoint_wall, density_limits(2)
       integer :: flags(3)
       integer(i8) :: last_checkpoint_step, first_step, particle_steps
-      logical :: at_output, checkpoint_due
+      logical :: at_output, checkpoint_due, landing
       character(len=:), allocatable :: outcome
 
       stopped_by = 0
@@ -88,11 +88,13 @@ contains
       end if
       diag = solver%diagnostics()
       if (progress%restarted) then
+         progress%next_output_index = output_index_of(progress%next_output_time, interval, end_time)
          call write_xdmf(solver, progress, status)
       else
          if (solver%domain%rank == 0) call csv%write_row(diagnostics_row(diag))
          call write_output(solver, progress, status)
-         progress%next_output_time = min(solver%time + interval, end_time)
+         progress%next_output_index = 1
+         progress%next_output_time = scheduled_output_time(progress%next_output_index, interval, end_time)
       end if
       call agree_on_status(status, solver%domain%comm)
       if (.not. status%ok) then
@@ -110,11 +112,12 @@ contains
       call solver%timers%switch_to(phase_other)
 
       do while (solver%time < end_time * (1.0_rp - 1.0e-12_rp) .and. solver%step < solver%run%max_steps)
-         ! land exactly on the next output time
-         if (solver%time + solver%dt * (1.0_rp + 1.0e-9_rp) >= progress%next_output_time) &
-            solver%dt = progress%next_output_time - solver%time
+         ! land exactly on the next output time (time + (next - time) may miss it by one ulp)
+         landing = solver%time + solver%dt * (1.0_rp + 1.0e-9_rp) >= progress%next_output_time
+         if (landing) solver%dt = progress%next_output_time - solver%time
          particle_steps = particle_steps + solver%particles%count
          call solver%advance()
+         if (landing) solver%time = progress%next_output_time
          call reporter%update(solver%time, solver%step, diag%particles, solver%domain%rank == 0)
 
          call solver%timers%switch_to(phase_health)
@@ -159,8 +162,10 @@ contains
             if (.not. status%ok) exit
             ! an output forced by max_steps before the output time keeps the schedule: a run continued
             ! from its checkpoint must still land on the output time it had not reached
-            if (solver%time >= progress%next_output_time * (1.0_rp - 1.0e-12_rp)) &
-               progress%next_output_time = min(progress%next_output_time + interval, end_time)
+            if (solver%time >= progress%next_output_time * (1.0_rp - 1.0e-12_rp)) then
+               progress%next_output_index = progress%next_output_index + 1
+               progress%next_output_time = scheduled_output_time(progress%next_output_index, interval, end_time)
+            end if
          end if
 
          checkpoint_due = flags(flag_signal) > 0 .or. flags(flag_wall_checkpoint) > 0
@@ -192,10 +197,11 @@ contains
       call records%close()
       call solver%timers%switch_to(phase_other)
       if (.not. status%ok .and. outcome == 'finished') outcome = 'failed'
+      if (outcome == 'finished' .and. solver%time < end_time * (1.0_rp - 1.0e-12_rp)) outcome = 'max_steps'
       block
          type(status_t) :: summary_status     ! a summary that cannot be written must not hide the run's own status
          call write_run_summary(dir, solver%domain%comm, reporter%elapsed(), solver%step - first_step, &
-                                particle_steps, outcome, summary_status)
+                                particle_steps, outcome, solver%time, summary_status)
          call write_timing(dir, solver%domain%comm, solver%timers%seconds, phase_names, summary_status)
          if (status%ok .and. .not. summary_status%ok) status = summary_status
       end block
