@@ -6,9 +6,9 @@
 !> Every rebalance_interval steps and at every output time the decomposition is rebalanced by particle
 !> count if it has drifted (solver%balance_load).
 !>
-!> After every step the ranks agree, in one small reduction, on three flags: an unhealthy particle
-!> somewhere, a termination signal received somewhere, and (rank 0's clock) a wall-time checkpoint
-!> being due. All ranks therefore take the same branch in the same step.
+!> After every step the ranks agree, in one small reduction, on four flags: an unhealthy particle
+!> somewhere, a termination signal received somewhere, (rank 0's clock) a wall-time checkpoint
+!> being due, and particle arrays that could not grow (out of memory) somewhere. All ranks therefore take the same branch in the same step.
 module simulation
    use kinds, only: rp, i8, name_len
    use mpi_f08, only: MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER, MPI_MAX
@@ -41,7 +41,7 @@ module simulation
    real(rp), parameter :: density_limit_factor = 100.0_rp
 
    !> Positions of the flags agreed on after every step.
-   integer, parameter :: flag_unhealthy = 1, flag_signal = 2, flag_wall_checkpoint = 3
+   integer, parameter :: flag_unhealthy = 1, flag_signal = 2, flag_wall_checkpoint = 3, flag_no_memory = 4
 
 contains
 
@@ -60,7 +60,7 @@ contains
       type(diagnostics_t) :: diag
       character(len=:), allocatable :: dir, checkpoint_path
       real(rp) :: end_time, interval, speed_limit, last_checkpoint_wall, density_limits(2)
-      integer :: flags(3)
+      integer :: flags(4)
       integer(i8) :: last_checkpoint_step, first_step, particle_steps
       logical :: at_output, checkpoint_due, landing
       character(len=:), allocatable :: outcome
@@ -124,6 +124,7 @@ contains
          flags = 0
          if (.not. particles_healthy(solver%particles, speed_limit, density_limits)) flags(flag_unhealthy) = 1
          flags(flag_signal) = received_termination_signal()
+         if (.not. solver%particles%allocation%ok) flags(flag_no_memory) = 1
          if (solver%domain%rank == 0 .and. solver%run%checkpoint_interval_wall > 0.0_rp) then
             if (reporter%elapsed() - last_checkpoint_wall >= solver%run%checkpoint_interval_wall) &
                flags(flag_wall_checkpoint) = 1
@@ -131,6 +132,11 @@ contains
          call MPI_Allreduce(MPI_IN_PLACE, flags, size(flags), MPI_INTEGER, MPI_MAX, solver%domain%comm)
          call solver%timers%switch_to(phase_other)
 
+         ! particles that found no room (inflow, migration): the state is incomplete, stop before reading it
+         if (flags(flag_no_memory) > 0) then
+            call solver%check_particle_memory(status)
+            exit
+         end if
          if (flags(flag_unhealthy) > 0) then
             call report_blow_up(solver, progress, speed_limit, density_limits, status)
             outcome = 'blew_up'
