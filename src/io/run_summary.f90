@@ -95,11 +95,19 @@ contains
       character(len=*), intent(in) :: outcome
       integer(i8), intent(in) :: steps
       real(rp), intent(in) :: simulated_time, wall_seconds, particle_steps_per_second
-      character(len=64) :: cost
+      character(len=64) :: cost, time
+      character(len=:), allocatable :: exact
       write (cost, '(f0.1,a,es8.2)') wall_seconds, ' s wall time, ', particle_steps_per_second
       if (cost(1:1) == '.') cost = '0'//cost(1:len(cost) - 1)
+      ! an output time prints as it was meant (1.0); a time between outputs in 6 digits, not 17
+      exact = real_text(simulated_time)
+      if (len(exact) <= 12) then
+         time = exact
+      else
+         write (time, '(es12.5)') simulated_time
+      end if
       write (error_unit, '(a)') 'flotsam: end of run: '//outcome//', '//int_text(steps)//' steps to t = '// &
-         real_text(simulated_time)//' s in '//trim(cost)//' particle-steps/s'
+         trim(adjustl(time))//' s in '//trim(cost)//' particle-steps/s'
       flush (error_unit)
    end subroutine print_final_line
 
