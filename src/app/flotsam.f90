@@ -1,6 +1,8 @@
 !> Flotsam driver: `mpirun -np N flotsam scene.nml [override.nml ...] [--set '<namelist text>' ...]
-!> [--overwrite] [--restart <checkpoint>|latest]`. Overrides apply in command-line order.
-!> The only place that touches MPI_COMM_WORLD and the only place that stops the program.
+!> [--overwrite] [--restart <checkpoint>|latest]`, or `flotsam --version`. Overrides apply in
+!> command-line order. The only place that touches MPI_COMM_WORLD and the only place that stops the
+!> program. A run starts its standard error with a banner (version, commit, ranks, scene, output
+!> folder) and ends it with one line of outcome and cost (run_summary), so a batch log shows what ran.
 !>
 !> Exit codes: 0 done; 2 scene, set-up or checkpoint refused; 3 output folder; 4 failure during the
 !> run (including a blow-up); 5 stopped by SIGTERM/SIGINT after writing a checkpoint.
@@ -17,8 +19,9 @@ program flotsam
    use run_progress, only: run_progress_t
    use checkpoint, only: read_checkpoint, latest_checkpoint_path
    use status_broadcast, only: broadcast_status
-   use input_text, only: int_text
+   use input_text, only: int_text, real_text
    use simulation, only: run_simulation
+   use build_info, only: flotsam_version, flotsam_git_commit, flotsam_build_type
    implicit none
 
    integer, parameter :: exit_scene = 2, exit_output_folder = 3, exit_run = 4, exit_signal = 5
@@ -47,6 +50,7 @@ program flotsam
       if (.not. status%ok) call fail(status, exit_scene)
       call prepare_output_directory(scene%run%output_dir, scene%run%overwrite, MPI_COMM_WORLD, status)
       if (.not. status%ok) call fail(status, exit_output_folder)
+      call print_banner()
    else
       call solver%init(scene, MPI_COMM_WORLD, status, seed_particles=.false.)
       if (.not. status%ok) call fail(status, exit_scene)
@@ -55,8 +59,9 @@ program flotsam
       call resolve_restart_path(restart_path, status)
       call read_checkpoint(restart_path, scene, solver, progress, status)
       if (.not. status%ok) call fail(status, exit_scene)
-      if (rank == 0) write (error_unit, '(a,i0,a,es12.5,a)') 'flotsam: continuing '//restart_path//' from step ', &
-         solver%step, ' (t = ', solver%time, ' s)'
+      call print_banner()
+      if (rank == 0) write (error_unit, '(a,i0,a)') 'flotsam: continuing '//restart_path//' from step ', &
+         solver%step, ' (t = '//real_text(solver%time)//' s)'
    end if
 
    call run_simulation(solver, progress, status, stopped_by)
@@ -109,6 +114,10 @@ contains
          select case (trim(arg))
          case ('-h', '--help')
             if (rank == 0) call print_usage(output_unit)
+            exit_code = 0
+            return
+         case ('--version')
+            if (rank == 0) call print_version(output_unit)
             exit_code = 0
             return
          case ('--overwrite')
@@ -200,10 +209,51 @@ contains
          '  --overwrite               replace a previous run in the output folder', &
          '  --restart <checkpoint>    continue the run from a checkpoint file of its output folder;', &
          '                            --restart latest takes the newest one (see docs/output.md)', &
+         '  --version                 print the version, git commit, build type, MPI and HDF5 libraries', &
          '  -h, --help                print this text', &
          'exit codes: 0 done, 2 scene or checkpoint refused, 3 output folder, 4 run failed,', &
          '            5 stopped by SIGTERM/SIGINT (a checkpoint was written)'
    end subroutine print_usage
+
+   !> `flotsam --version`: what this binary is and the libraries it runs on.
+   subroutine print_version(unit)
+      use mpi_f08, only: MPI_Get_library_version, MPI_MAX_LIBRARY_VERSION_STRING
+      use hdf5, only: h5get_libversion_f
+      integer, intent(in) :: unit
+      character(len=MPI_MAX_LIBRARY_VERSION_STRING) :: mpi_library
+      integer :: length, major, minor, release, error, i
+      call MPI_Get_library_version(mpi_library, length)
+      ! Open MPI's string ends in a newline; keep the text on one line
+      do i = 1, length
+         if (iachar(mpi_library(i:i)) < 32) mpi_library(i:i) = ' '
+      end do
+      call h5get_libversion_f(major, minor, release, error)
+      write (unit, '(a)') 'flotsam '//flotsam_version, &
+         'commit '//flotsam_git_commit, &
+         'build type '//flotsam_build_type, &
+         'MPI library '//trim(mpi_library(1:length))
+      if (error == 0) then
+         write (unit, '(a)') 'HDF5 library '//int_text(major)//'.'//int_text(minor)//'.'//int_text(release)
+      else
+         write (unit, '(a)') 'HDF5 library unknown'
+      end if
+   end subroutine print_version
+
+   !> Rank 0 names what runs: version, commit, ranks, scene file (and its overrides), output folder.
+   subroutine print_banner()
+      use mpi_f08, only: MPI_Comm_size
+      integer :: ranks
+      character(len=:), allocatable :: changes
+      call MPI_Comm_size(MPI_COMM_WORLD, ranks)
+      if (rank /= 0) return
+      changes = ''
+      if (size(overrides) == 1) changes = ' with 1 override'
+      if (size(overrides) > 1) changes = ' with '//int_text(size(overrides))//' overrides'
+      write (error_unit, '(a)') 'flotsam '//flotsam_version//' (commit '//flotsam_git_commit//', '// &
+         flotsam_build_type//' build) on '//int_text(ranks)//' rank'//trim(merge('s', ' ', ranks > 1))// &
+         ': scene '//scene_path//changes//', output folder '//trim(scene%run%output_dir)
+      flush (error_unit)
+   end subroutine print_banner
 
    !> Every rank holds the same failed status: rank 0 reports it, all ranks exit with `code`.
    subroutine fail(failed, code)

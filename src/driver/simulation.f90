@@ -6,9 +6,9 @@
 !> Every rebalance_interval steps and at every output time the decomposition is rebalanced by particle
 !> count if it has drifted (solver%balance_load).
 !>
-!> After every step the ranks agree, in one small reduction, on three flags: an unhealthy particle
-!> somewhere, a termination signal received somewhere, and (rank 0's clock) a wall-time checkpoint
-!> being due. All ranks therefore take the same branch in the same step.
+!> After every step the ranks agree, in one small reduction, on four flags: an unhealthy particle
+!> somewhere, a termination signal received somewhere, (rank 0's clock) a wall-time checkpoint
+!> being due, and particle arrays that could not grow (out of memory) somewhere. All ranks therefore take the same branch in the same step.
 module simulation
    use kinds, only: rp, i8, name_len
    use mpi_f08, only: MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER, MPI_MAX
@@ -24,7 +24,7 @@ module simulation
    use status_broadcast, only: broadcast_status, agree_on_status
    use health_check, only: particles_healthy, describe_unhealthy_particle
    use termination_signals, only: install_termination_handlers, received_termination_signal, signal_name
-   use run_progress, only: run_progress_t
+   use run_progress, only: run_progress_t, scheduled_output_time, output_index_of
    use xdmf_writer, only: output_entry_t, write_particles_xdmf, write_grid_xdmf
    use field_output, only: write_fields, particle_xdmf_attributes, grid_xdmf_attributes
    use checkpoint, only: write_checkpoint
@@ -41,7 +41,7 @@ module simulation
    real(rp), parameter :: density_limit_factor = 100.0_rp
 
    !> Positions of the flags agreed on after every step.
-   integer, parameter :: flag_unhealthy = 1, flag_signal = 2, flag_wall_checkpoint = 3
+   integer, parameter :: flag_unhealthy = 1, flag_signal = 2, flag_wall_checkpoint = 3, flag_no_memory = 4
 
 contains
 
@@ -60,9 +60,9 @@ contains
       type(diagnostics_t) :: diag
       character(len=:), allocatable :: dir, checkpoint_path
       real(rp) :: end_time, interval, speed_limit, last_checkpoint_wall, density_limits(2)
-      integer :: flags(3)
+      integer :: flags(4)
       integer(i8) :: last_checkpoint_step, first_step, particle_steps
-      logical :: at_output, checkpoint_due
+      logical :: at_output, checkpoint_due, landing
       character(len=:), allocatable :: outcome
 
       stopped_by = 0
@@ -88,11 +88,13 @@ contains
       end if
       diag = solver%diagnostics()
       if (progress%restarted) then
+         progress%next_output_index = output_index_of(progress%next_output_time, interval, end_time)
          call write_xdmf(solver, progress, status)
       else
          if (solver%domain%rank == 0) call csv%write_row(diagnostics_row(diag))
          call write_output(solver, progress, status)
-         progress%next_output_time = min(solver%time + interval, end_time)
+         progress%next_output_index = 1
+         progress%next_output_time = scheduled_output_time(progress%next_output_index, interval, end_time)
       end if
       call agree_on_status(status, solver%domain%comm)
       if (.not. status%ok) then
@@ -110,17 +112,19 @@ contains
       call solver%timers%switch_to(phase_other)
 
       do while (solver%time < end_time * (1.0_rp - 1.0e-12_rp) .and. solver%step < solver%run%max_steps)
-         ! land exactly on the next output time
-         if (solver%time + solver%dt * (1.0_rp + 1.0e-9_rp) >= progress%next_output_time) &
-            solver%dt = progress%next_output_time - solver%time
+         ! land exactly on the next output time (time + (next - time) may miss it by one ulp)
+         landing = solver%time + solver%dt * (1.0_rp + 1.0e-9_rp) >= progress%next_output_time
+         if (landing) solver%dt = progress%next_output_time - solver%time
          particle_steps = particle_steps + solver%particles%count
          call solver%advance()
+         if (landing) solver%time = progress%next_output_time
          call reporter%update(solver%time, solver%step, diag%particles, solver%domain%rank == 0)
 
          call solver%timers%switch_to(phase_health)
          flags = 0
          if (.not. particles_healthy(solver%particles, speed_limit, density_limits)) flags(flag_unhealthy) = 1
          flags(flag_signal) = received_termination_signal()
+         if (.not. solver%particles%allocation%ok) flags(flag_no_memory) = 1
          if (solver%domain%rank == 0 .and. solver%run%checkpoint_interval_wall > 0.0_rp) then
             if (reporter%elapsed() - last_checkpoint_wall >= solver%run%checkpoint_interval_wall) &
                flags(flag_wall_checkpoint) = 1
@@ -128,6 +132,11 @@ contains
          call MPI_Allreduce(MPI_IN_PLACE, flags, size(flags), MPI_INTEGER, MPI_MAX, solver%domain%comm)
          call solver%timers%switch_to(phase_other)
 
+         ! particles that found no room (inflow, migration): the state is incomplete, stop before reading it
+         if (flags(flag_no_memory) > 0) then
+            call solver%check_particle_memory(status)
+            exit
+         end if
          if (flags(flag_unhealthy) > 0) then
             call report_blow_up(solver, progress, speed_limit, density_limits, status)
             outcome = 'blew_up'
@@ -159,8 +168,10 @@ contains
             if (.not. status%ok) exit
             ! an output forced by max_steps before the output time keeps the schedule: a run continued
             ! from its checkpoint must still land on the output time it had not reached
-            if (solver%time >= progress%next_output_time * (1.0_rp - 1.0e-12_rp)) &
-               progress%next_output_time = min(progress%next_output_time + interval, end_time)
+            if (solver%time >= progress%next_output_time * (1.0_rp - 1.0e-12_rp)) then
+               progress%next_output_index = progress%next_output_index + 1
+               progress%next_output_time = scheduled_output_time(progress%next_output_index, interval, end_time)
+            end if
          end if
 
          checkpoint_due = flags(flag_signal) > 0 .or. flags(flag_wall_checkpoint) > 0
@@ -192,10 +203,11 @@ contains
       call records%close()
       call solver%timers%switch_to(phase_other)
       if (.not. status%ok .and. outcome == 'finished') outcome = 'failed'
+      if (outcome == 'finished' .and. solver%time < end_time * (1.0_rp - 1.0e-12_rp)) outcome = 'max_steps'
       block
          type(status_t) :: summary_status     ! a summary that cannot be written must not hide the run's own status
          call write_run_summary(dir, solver%domain%comm, reporter%elapsed(), solver%step - first_step, &
-                                particle_steps, outcome, summary_status)
+                                particle_steps, outcome, solver%time, summary_status)
          call write_timing(dir, solver%domain%comm, solver%timers%seconds, phase_names, summary_status)
          if (status%ok .and. .not. summary_status%ok) status = summary_status
       end block

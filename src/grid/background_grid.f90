@@ -6,7 +6,10 @@
 !> quantities that particles accumulate (P2G) live in one array `accumulated(:, node)` so that the
 !> ghost-node sum exchanges them all in one message.
 module background_grid
-   use kinds, only: rp
+   use kinds, only: rp, i8
+   use error_status, only: status_t
+   use memory_budget, only: byte_text
+   use input_text, only: int_text
    use shape_functions, only: n_corners, corner_offset
    use domain_decomposition, only: domain_t
    use world_frame, only: frame_t
@@ -48,12 +51,13 @@ module background_grid
 contains
 
    !> Size the local node box from the owned cells of `domain`.
-   subroutine grid_init(self, domain, origin, h, frame)
+   subroutine grid_init(self, domain, origin, h, frame, status)
       class(grid_t), intent(inout) :: self
       type(domain_t), intent(in) :: domain
       real(rp), intent(in) :: origin(3), h
       type(frame_t), intent(in), optional :: frame
-      integer :: a, k, stride(3)
+      type(status_t), intent(inout), optional :: status   !< fails if the node arrays cannot be allocated
+      integer :: a, k, stride(3), stat
 
       self%dim = domain%dim
       self%h = h
@@ -91,8 +95,19 @@ contains
       self%row_force = self%row_momentum + self%dim
       self%n_rows = 1 + 2 * self%dim
       if (allocated(self%accumulated)) deallocate (self%accumulated, self%velocity, self%velocity_increment)
-      allocate (self%accumulated(self%n_rows, self%node_count))
-      allocate (self%velocity(self%dim, self%node_count), self%velocity_increment(self%dim, self%node_count))
+      allocate (self%accumulated(self%n_rows, self%node_count), self%velocity(self%dim, self%node_count), &
+                self%velocity_increment(self%dim, self%node_count), stat=stat)
+      if (stat /= 0) then
+         ! no memory for this block: the caller stops; empty arrays keep the grid a valid object until then
+         if (allocated(self%accumulated)) deallocate (self%accumulated)
+         if (allocated(self%velocity)) deallocate (self%velocity)
+         if (allocated(self%velocity_increment)) deallocate (self%velocity_increment)
+         allocate (self%accumulated(self%n_rows, 0), self%velocity(self%dim, 0), self%velocity_increment(self%dim, 0))
+         if (present(status)) call status%fail('no memory for the grid: '//byte_text(8_i8 * (self%n_rows + 2 * self%dim) * &
+                                                                                      int(self%node_count, i8))// &
+                                               ' for '//int_text(self%node_count)//' nodes on one rank')
+         return
+      end if
       self%accumulated = 0.0_rp
       self%velocity = 0.0_rp
       self%velocity_increment = 0.0_rp

@@ -6,13 +6,14 @@
 !> (which start from the scene's current values), the repeated groups, the checks that the base file
 !> gives every required variable, and finally `validate_scene` / `resolve_scene` on the whole scene.
 module scene_reader
-   use mpi_f08, only: MPI_Comm, MPI_Comm_rank
+   use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_size
+   use memory_budget, only: memory_budget_t, measure_memory_budget
    use kinds, only: rp, i8, path_len
    use error_status, only: status_t
    use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
                                 inlet_spec_t, gauge_spec_t, model_newtonian_fluid, model_linear_elastic
    use namelist_scan, only: namelist_file_t, namelist_group_t, scan_namelist_file
-   use scene_validation, only: validate_scene, resolve_scene, default_name, stabilization_keywords, &
+   use scene_validation, only: validate_scene, resolve_scene, check_scene_memory, default_name, stabilization_keywords, &
                                oscillation_rule_keywords
    use scene_broadcast, only: broadcast_scene
    use status_broadcast, only: broadcast_status
@@ -161,10 +162,13 @@ contains
       type(status_t), intent(out) :: status
       type(scene_override_t), intent(in), optional :: overrides(:)
       type(scene_t) :: empty_scene
+      type(memory_budget_t) :: budget
       character(len=:), allocatable :: label
-      integer :: rank, i
+      integer :: rank, ranks, i
 
       call MPI_Comm_rank(comm, rank)
+      call MPI_Comm_size(comm, ranks)
+      budget = measure_memory_budget(comm)
       if (rank == root) then
          call load_scene_file(path, scene, status)
          label = trim(path)
@@ -181,6 +185,8 @@ contains
          end if
          if (status%ok) call validate_scene(scene, label, status)
          if (status%ok) call resolve_scene(scene)
+         ! before any particle is made: a scene too large for the machine is refused, not run out of memory
+         if (status%ok) call check_scene_memory(scene, label, ranks, budget, status)
       end if
       call broadcast_status(status, comm, root)
       if (status%ok) then
@@ -230,9 +236,31 @@ contains
          call status%fail(override_label(override, i)//': cannot read the override: '//trim(message))
          return
       end if
+      if (.not. override%is_text) then
+         if (is_whole_scene(unit, override%source)) then
+            call status%fail(override%source//' is a whole scene, not an override file: flotsam runs one scene '// &
+                             '(usage: flotsam <scene.nml> [override.nml ...] [--set <text> ...]; see flotsam --help)')
+            close (unit)
+            return
+         end if
+      end if
       call read_override(unit, override_label(override, i), scene, status)
       close (unit)
    end subroutine apply_override
+
+   !> True if the file open on `unit` would be accepted as a scene file by itself (every required
+   !> group and variable): `flotsam a.nml b.nml` with two scenes would otherwise run b.nml's changes to
+   !> a.nml. An override that changes many entries still lacks required variables (&grid dim, ...).
+   logical function is_whole_scene(unit, path) result(whole)
+      integer, intent(in) :: unit
+      character(len=*), intent(in) :: path
+      type(scene_t) :: probe
+      type(status_t) :: probe_status
+      rewind (unit)
+      call read_base_file(unit, path, probe, probe_status)
+      whole = probe_status%ok
+      rewind (unit)
+   end function is_whole_scene
 
    !> The groups of an override open on `unit` change the scene in place.
    subroutine read_override(unit, label, scene, status)

@@ -10,10 +10,20 @@ module scene_validation
                                 inlet_spec_t, gauge_spec_t, opening_far_end, wall_none, wall_slip, wall_no_slip, &
                                 model_newtonian_fluid, model_linear_elastic, gauge_pressure, gauge_level, gauge_velocity
    use input_text, only: int_text, real_text, quoted_list, group_context, ordinal
+   use memory_budget, only: memory_budget_t, byte_text
    implicit none
    private
 
    public :: validate_scene, resolve_scene, find_material, default_name, side_name
+   public :: check_scene_memory, scene_particle_count, memory_estimate_per_rank
+
+   !> Peak resident memory per particle a run grows by [bytes]: particle arrays, sort buffers and the
+   !> fields file's buffers, measured as the slope of run_summary.csv's peak_memory_bytes over the
+   !> particle count (dam break at 6/12/24 particles per cell: 300 to 344; 3-D column at 1/2/3: 320).
+   integer(i8), parameter :: bytes_per_particle(2:3) = [300_i8, 320_i8]
+   !> Grid memory per node [bytes]: mass, momentum, force, velocity and its increment, MUSL's remapped
+   !> momentum (1 + 5 dim reals), doubled for halos, stabilization and grid output. [R]
+   integer(i8), parameter :: bytes_per_node(2:3) = [2_i8 * 8_i8 * 11_i8, 2_i8 * 8_i8 * 16_i8]
 
    !> Accepted `&material stabilization=` keywords in their canonical spelling (compared without case).
    character(len=*), parameter, public :: stabilization_keywords(*) = [character(len=5) :: 'none', 'C0', 'NB', 'FOAL1']
@@ -115,6 +125,127 @@ contains
       end if
       call validate_load_names(scene, path, status)
    end subroutine validate_scene
+
+   !> Particles body b (b > 0) or inlet -b (b < 0) of the scene creates over the run (a real: a bad
+   !> scene may ask for more than any integer holds). Bodies: the lattice of particle_seeding; inlets:
+   !> the layers that exist at end_time times the particles across the opening (fluid_inflow).
+   real(rp) function source_particle_count(scene, b) result(n)
+      type(scene_t), intent(in) :: scene
+      integer, intent(in) :: b
+      real(rp) :: spacing, length
+      integer :: k, dim
+      dim = scene%grid%dim
+      n = 1.0_rp
+      if (b > 0) then
+         associate (body => scene%bodies(b))
+            spacing = scene%grid%cell_size / body%particles_per_cell
+            do k = 1, dim
+               n = n * anint((body%upper(k) - body%lower(k)) / spacing)
+            end do
+         end associate
+      else
+         associate (inlet => scene%inlets(-b))
+            spacing = scene%grid%cell_size / inlet%particles_per_cell
+            length = inlet%velocity * max(0.0_rp, min(scene%run%end_time, inlet%end_time) - inlet%start_time)
+            n = aint(length / spacing) * max(1.0_rp, anint(inlet%height / spacing))
+            if (dim == 3) n = n * max(1.0_rp, anint(inlet%width / spacing))
+         end associate
+      end if
+   end function source_particle_count
+
+   !> Particles all bodies and inlets create over the run.
+   real(rp) function scene_particle_count(scene) result(n)
+      type(scene_t), intent(in) :: scene
+      integer :: b
+      n = 0.0_rp
+      do b = 1, body_count(scene)
+         n = n + source_particle_count(scene, b)
+      end do
+      do b = 1, inlet_count(scene)
+         n = n + source_particle_count(scene, -b)
+      end do
+   end function scene_particle_count
+
+   !> Memory one of `ranks` ranks needs at least for the scene [bytes, as a real]: its share of the
+   !> particles at bytes_per_particle, and its share of the nodes of the grid around the bodies (the
+   !> active region the run starts with; it grows as the material spreads) at bytes_per_node.
+   real(rp) function memory_estimate_per_rank(scene, ranks) result(bytes)
+      type(scene_t), intent(in) :: scene
+      integer, intent(in) :: ranks
+      real(rp) :: nodes, box
+      integer :: b, k, dim
+      dim = scene%grid%dim
+      nodes = 0.0_rp
+      do b = 1, body_count(scene)
+         box = 1.0_rp
+         do k = 1, dim
+            box = box * (aint((scene%bodies(b)%upper(k) - scene%bodies(b)%lower(k)) / scene%grid%cell_size) + 3.0_rp)
+         end do
+         nodes = nodes + box
+      end do
+      bytes = (real(bytes_per_particle(dim), rp) * scene_particle_count(scene) + real(bytes_per_node(dim), rp) * nodes) &
+              / ranks
+   end function memory_estimate_per_rank
+
+   !> Refuse a scene whose particles cannot fit: more than a rank can count (default integers), or an
+   !> estimate per rank (memory_estimate_per_rank, an even share) above what every rank has
+   !> (`budget`, memory_budget; not checked when unknown). The message names the body or inlet that
+   !> makes the most particles, e.g. `dam.nml: group &body (1st, material 'water'): variable
+   !> particles_per_cell = 100 makes 25000000 particles (25000000 in the scene), about 3.8 GB per rank
+   !> on 2 ranks, more than the 1.2 GB per rank available (...)`. Call on a validated scene.
+   subroutine check_scene_memory(scene, path, ranks, budget, status)
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: path
+      integer, intent(in) :: ranks
+      type(memory_budget_t), intent(in) :: budget
+      type(status_t), intent(inout) :: status
+      real(rp) :: total, estimate, largest, n
+      integer :: b, biggest, ppc
+      character(len=:), allocatable :: where, made
+
+      total = scene_particle_count(scene)
+      estimate = memory_estimate_per_rank(scene, ranks)
+      if (total / ranks <= real(huge(1), rp) .and. &
+          (budget%per_rank < 0 .or. estimate <= real(budget%per_rank, rp))) return
+      largest = -1.0_rp
+      biggest = 0
+      do b = -inlet_count(scene), body_count(scene)
+         if (b == 0) cycle
+         n = source_particle_count(scene, b)
+         if (n > largest) then
+            largest = n
+            biggest = b
+         end if
+      end do
+      if (biggest > 0) then
+         where = group_context(path, 'body', biggest, "material '"//trim(scene%bodies(biggest)%material)//"'")
+         ppc = scene%bodies(biggest)%particles_per_cell
+      else
+         where = group_context(path, 'inlet', -biggest, "material '"//trim(scene%inlets(-biggest)%material)//"'")
+         ppc = scene%inlets(-biggest)%particles_per_cell
+      end if
+      made = where//': variable particles_per_cell = '//int_text(ppc)//' makes '//count_text(largest)//' particles'
+      if (total > largest) made = made//' ('//count_text(total)//' in the scene)'
+      made = made//', about '//byte_text(estimate)//' per rank on '//int_text(ranks)//' rank'//trim(merge('s', ' ', ranks > 1))
+      if (budget%per_rank >= 0 .and. estimate > real(budget%per_rank, rp)) then
+         call status%fail(made//', more than the '//budget%describe()//' available')
+      else
+         call status%fail(made//', more particles than one rank can hold ('//int_text(huge(1))//')')
+      end if
+   end subroutine check_scene_memory
+
+   !> A particle count: the integer below 1e18, else in exponent form.
+   function count_text(n) result(text)
+      real(rp), intent(in) :: n
+      character(len=:), allocatable :: text
+      character(len=16) :: buffer
+      if (n < 1.0e18_rp) then
+         text = int_text(int(n, i8))
+      else
+         write (buffer, '(es10.3)') n
+         text = trim(adjustl(buffer))
+      end if
+   end function count_text
 
    pure integer function body_count(scene)
       type(scene_t), intent(in) :: scene

@@ -330,6 +330,8 @@ contains
       do p = 1, n
          call solver%particles%add(x(:, p), v(:, p), mass(p), density(p), sbar(:, p), material(p), id(p))
       end do
+      call solver%check_particle_memory(status)
+      if (.not. status%ok) return
       solver%time = time
       solver%step = step
       solver%dt = dt

@@ -3,10 +3,13 @@
 !>   wall_seconds, steps, particle_steps, particle_steps_per_second_per_core, ranks,
 !>   peak_memory_bytes (largest rank), peak_memory_bytes_total (all ranks), outcome
 !> Steps and particle-steps count this invocation only (a restarted run reports its continuation).
+!> The same figures end the run's standard error, one line for a batch log:
+!>   flotsam: end of run: finished, 480 steps to t = 1.0 s in 12.3 s wall time, 8.6e+05 particle-steps/s
 !> `timing.csv` beside it: the time loop's wall time per phase (phase_timers), one row per phase:
 !>   phase, seconds_max (the slowest rank's), seconds_mean (over the ranks), share (of the mean loop time)
 !> and a last row `total` (seconds_max: the largest of the ranks' sums, not the sum of the maxima).
 module run_summary
+   use, intrinsic :: iso_fortran_env, only: error_unit
    use kinds, only: rp, i8
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_Comm_rank, MPI_Comm_size, MPI_IN_PLACE, MPI_INTEGER8, &
                       MPI_DOUBLE_PRECISION, MPI_SUM, MPI_MAX
@@ -24,12 +27,14 @@ module run_summary
 
 contains
 
-   !> Collective over `comm`: rank 0 writes <dir>/run_summary.csv (replacing it) with the totals.
-   !> local_particle_steps: the sum over this invocation's steps of this rank's particle count.
-   subroutine write_run_summary(dir, comm, wall_seconds, steps, local_particle_steps, outcome, status)
+   !> Collective over `comm`: rank 0 writes <dir>/run_summary.csv (replacing it) with the totals and
+   !> prints the final line on standard error. local_particle_steps: the sum over this invocation's
+   !> steps of this rank's particle count; simulated_time: the time the run stopped at [s]; outcome:
+   !> finished, max_steps, blew_up, stopped_by_signal or failed.
+   subroutine write_run_summary(dir, comm, wall_seconds, steps, local_particle_steps, outcome, simulated_time, status)
       character(len=*), intent(in) :: dir, outcome
       type(MPI_Comm), intent(in) :: comm
-      real(rp), intent(in) :: wall_seconds
+      real(rp), intent(in) :: wall_seconds, simulated_time
       integer(i8), intent(in) :: steps, local_particle_steps
       type(status_t), intent(inout) :: status
       integer(i8) :: particle_steps, peak(1), total(1)
@@ -47,6 +52,7 @@ contains
       if (rank /= 0) return
       rate = 0.0_rp
       if (wall_seconds > 0.0_rp) rate = real(particle_steps, rp) / (wall_seconds * ranks)
+      call print_final_line(outcome, steps, simulated_time, wall_seconds, rate * ranks)
       if (.not. opened(dir, run_summary_file, unit, status)) return
       write (unit, '(a)') 'wall_seconds,steps,particle_steps,particle_steps_per_second_per_core,ranks,'// &
          'peak_memory_bytes,peak_memory_bytes_total,outcome'
@@ -83,6 +89,27 @@ contains
       write (unit, '(a)') 'total,'//real_text(largest_total)//','//real_text(total)//',1'
       call publish(dir, timing_file, unit, status)
    end subroutine write_timing
+
+   !> The run's last line on standard error (rank 0): what ended it and what it cost.
+   subroutine print_final_line(outcome, steps, simulated_time, wall_seconds, particle_steps_per_second)
+      character(len=*), intent(in) :: outcome
+      integer(i8), intent(in) :: steps
+      real(rp), intent(in) :: simulated_time, wall_seconds, particle_steps_per_second
+      character(len=64) :: cost, time
+      character(len=:), allocatable :: exact
+      write (cost, '(f0.1,a,es8.2)') wall_seconds, ' s wall time, ', particle_steps_per_second
+      if (cost(1:1) == '.') cost = '0'//cost(1:len(cost) - 1)
+      ! an output time prints as it was meant (1.0); a time between outputs in 6 digits, not 17
+      exact = real_text(simulated_time)
+      if (len(exact) <= 12) then
+         time = exact
+      else
+         write (time, '(es12.5)') simulated_time
+      end if
+      write (error_unit, '(a)') 'flotsam: end of run: '//outcome//', '//int_text(steps)//' steps to t = '// &
+         trim(adjustl(time))//' s in '//trim(cost)//' particle-steps/s'
+      flush (error_unit)
+   end subroutine print_final_line
 
    !> Open <dir>/<name>.tmp for writing as `unit`; false (and status failed) if it cannot be.
    logical function opened(dir, name, unit, status)

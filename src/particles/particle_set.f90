@@ -5,8 +5,15 @@
 !> and the spin. After `sort_by_material_and_cell` the particles of material m occupy the contiguous
 !> range material_first(m):material_last(m), ordered by cell, so material updates and cell sums run
 !> over contiguous slices.
+!>
+!> Growing the arrays can fail for want of memory: `allocation` then fails (the first failure wins),
+!> the set keeps the particles it had (an `add` that finds no room drops its particle), and the caller
+!> stops the run with that message (solver_t%check_particle_memory) instead of a runtime error.
 module particle_set
    use kinds, only: rp, i8
+   use error_status, only: status_t
+   use memory_budget, only: byte_text
+   use input_text, only: int_text
    use tensor_layout, only: n_components, n_spin
    implicit none
    private
@@ -25,6 +32,7 @@ module particle_set
       real(rp), allocatable :: strain_rate(:, :)    !< d_p, replaced by d~_p when filtered (n_sigma, p)
       real(rp), allocatable :: spin(:, :)           !< w_p components (n_spin, p)
       integer, allocatable :: material_first(:), material_last(:)
+      type(status_t) :: allocation                  !< failed if the arrays could not grow
    contains
       procedure :: init => particles_init
       procedure :: reserve => particles_reserve
@@ -47,7 +55,9 @@ contains
       self%n_spin = n_spin(dim)
       self%n_materials = n_materials
       self%count = 0
+      call self%allocation%reset()
       if (allocated(self%x)) call free_arrays(self)
+      if (allocated(self%material_first)) deallocate (self%material_first, self%material_last)
       call allocate_arrays(self, max(capacity, 16))
       allocate (self%material_first(n_materials), self%material_last(n_materials))
       self%material_first = 1
@@ -57,17 +67,47 @@ contains
    subroutine allocate_arrays(self, capacity)
       type(particle_set_t), intent(inout) :: self
       integer, intent(in) :: capacity
+      integer :: stat
       allocate (self%x(self%dim, capacity), self%v(self%dim, capacity), self%mass(capacity), &
                 self%density(capacity), self%sbar(self%n_sigma, capacity), self%material(capacity), &
                 self%id(capacity), self%cell(capacity), self%strain_rate(self%n_sigma, capacity), &
-                self%spin(self%n_spin, capacity))
+                self%spin(self%n_spin, capacity), stat=stat)
+      if (stat == 0) return
+      call no_memory(self, capacity)
+      ! an empty set, so that the caller can still report and stop
+      call free_arrays(self)
+      allocate (self%x(self%dim, 0), self%v(self%dim, 0), self%mass(0), self%density(0), self%sbar(self%n_sigma, 0), &
+                self%material(0), self%id(0), self%cell(0), self%strain_rate(self%n_sigma, 0), self%spin(self%n_spin, 0))
    end subroutine allocate_arrays
+
+   !> Record that room for `capacity` particles could not be allocated.
+   subroutine no_memory(self, capacity)
+      type(particle_set_t), intent(inout) :: self
+      integer, intent(in) :: capacity
+      call self%allocation%fail('no memory for '//int_text(capacity)//' particles ('//byte_text(int(capacity, i8) * &
+                                particle_bytes(self))//' for the particle arrays); use more ranks or nodes, or fewer '// &
+                                'particles per cell')
+   end subroutine no_memory
+
+   !> Bytes of the particle arrays per particle.
+   pure integer(i8) function particle_bytes(self)
+      type(particle_set_t), intent(in) :: self
+      particle_bytes = 8_i8 * (2 * self%dim + 2 + 2 * self%n_sigma + self%n_spin + 1) + 4_i8 * 2
+   end function particle_bytes
 
    subroutine free_arrays(self)
       type(particle_set_t), intent(inout) :: self
-      deallocate (self%x, self%v, self%mass, self%density, self%sbar, self%material, self%id, self%cell, &
-                  self%strain_rate, self%spin)
-      if (allocated(self%material_first)) deallocate (self%material_first, self%material_last)
+      ! each on its own: a failed allocate may have left some of them unallocated
+      if (allocated(self%x)) deallocate (self%x)
+      if (allocated(self%v)) deallocate (self%v)
+      if (allocated(self%mass)) deallocate (self%mass)
+      if (allocated(self%density)) deallocate (self%density)
+      if (allocated(self%sbar)) deallocate (self%sbar)
+      if (allocated(self%material)) deallocate (self%material)
+      if (allocated(self%id)) deallocate (self%id)
+      if (allocated(self%cell)) deallocate (self%cell)
+      if (allocated(self%strain_rate)) deallocate (self%strain_rate)
+      if (allocated(self%spin)) deallocate (self%spin)
    end subroutine free_arrays
 
    !> Make room for at least `capacity` particles, keeping the first `count`.
@@ -81,71 +121,91 @@ contains
 
    !> Move particle p to slot dest(p) (a permutation of 1..count) in arrays of `capacity` slots.
    !> The scratch arrays (rate of deformation, spin) are not carried: they are rebuilt every step.
+   !> Without memory for a new array the set is left as it was before that array (arrays already moved
+   !> stay moved: the contents are then inconsistent, and the run stops at the end of the step).
    subroutine particles_reorder(self, dest, capacity)
       class(particle_set_t), intent(inout) :: self
       integer, intent(in) :: dest(:), capacity
-      call reorder_real2(self%x, dest, capacity)
-      call reorder_real2(self%v, dest, capacity)
-      call reorder_real1(self%mass, dest, capacity)
-      call reorder_real1(self%density, dest, capacity)
-      call reorder_real2(self%sbar, dest, capacity)
-      call reorder_int1(self%material, dest, capacity)
-      call reorder_int1(self%cell, dest, capacity)
-      call reorder_i8(self%id, dest, capacity)
-      if (capacity /= size(self%strain_rate, 2)) then
+      logical :: ok
+      integer :: stat
+      ok = reorder_real2(self%x, dest, capacity)
+      if (ok) ok = reorder_real2(self%v, dest, capacity)
+      if (ok) ok = reorder_real1(self%mass, dest, capacity)
+      if (ok) ok = reorder_real1(self%density, dest, capacity)
+      if (ok) ok = reorder_real2(self%sbar, dest, capacity)
+      if (ok) ok = reorder_int1(self%material, dest, capacity)
+      if (ok) ok = reorder_int1(self%cell, dest, capacity)
+      if (ok) ok = reorder_i8(self%id, dest, capacity)
+      if (ok .and. capacity /= size(self%strain_rate, 2)) then
          deallocate (self%strain_rate, self%spin)
-         allocate (self%strain_rate(self%n_sigma, capacity), self%spin(self%n_spin, capacity))
+         allocate (self%strain_rate(self%n_sigma, capacity), self%spin(self%n_spin, capacity), stat=stat)
+         if (stat /= 0) then
+            if (allocated(self%strain_rate)) deallocate (self%strain_rate)
+            if (allocated(self%spin)) deallocate (self%spin)
+            allocate (self%strain_rate(self%n_sigma, 0), self%spin(self%n_spin, 0))
+            ok = .false.
+         end if
       end if
+      if (.not. ok) call no_memory(self, capacity)
    end subroutine particles_reorder
 
-   ! One routine per array type (Fortran has no generics over types): b(dest(p)) = a(p).
-   subroutine reorder_real2(a, dest, capacity)
+   ! One routine per array type (Fortran has no generics over types): b(dest(p)) = a(p); false (a
+   ! unchanged) without memory for b.
+   logical function reorder_real2(a, dest, capacity) result(ok)
       real(rp), allocatable, intent(inout) :: a(:, :)
       integer, intent(in) :: dest(:), capacity
       real(rp), allocatable :: b(:, :)
-      integer :: p
-      allocate (b(size(a, 1), capacity))
+      integer :: p, stat
+      allocate (b(size(a, 1), capacity), stat=stat)
+      ok = stat == 0
+      if (.not. ok) return
       do p = 1, size(dest)
          b(:, dest(p)) = a(:, p)
       end do
       call move_alloc(b, a)
-   end subroutine reorder_real2
+   end function reorder_real2
 
-   subroutine reorder_real1(a, dest, capacity)
+   logical function reorder_real1(a, dest, capacity) result(ok)
       real(rp), allocatable, intent(inout) :: a(:)
       integer, intent(in) :: dest(:), capacity
       real(rp), allocatable :: b(:)
-      integer :: p
-      allocate (b(capacity))
+      integer :: p, stat
+      allocate (b(capacity), stat=stat)
+      ok = stat == 0
+      if (.not. ok) return
       do p = 1, size(dest)
          b(dest(p)) = a(p)
       end do
       call move_alloc(b, a)
-   end subroutine reorder_real1
+   end function reorder_real1
 
-   subroutine reorder_int1(a, dest, capacity)
+   logical function reorder_int1(a, dest, capacity) result(ok)
       integer, allocatable, intent(inout) :: a(:)
       integer, intent(in) :: dest(:), capacity
       integer, allocatable :: b(:)
-      integer :: p
-      allocate (b(capacity))
+      integer :: p, stat
+      allocate (b(capacity), stat=stat)
+      ok = stat == 0
+      if (.not. ok) return
       do p = 1, size(dest)
          b(dest(p)) = a(p)
       end do
       call move_alloc(b, a)
-   end subroutine reorder_int1
+   end function reorder_int1
 
-   subroutine reorder_i8(a, dest, capacity)
+   logical function reorder_i8(a, dest, capacity) result(ok)
       integer(i8), allocatable, intent(inout) :: a(:)
       integer, intent(in) :: dest(:), capacity
       integer(i8), allocatable :: b(:)
-      integer :: p
-      allocate (b(capacity))
+      integer :: p, stat
+      allocate (b(capacity), stat=stat)
+      ok = stat == 0
+      if (.not. ok) return
       do p = 1, size(dest)
          b(dest(p)) = a(p)
       end do
       call move_alloc(b, a)
-   end subroutine reorder_i8
+   end function reorder_i8
 
    !> Reals needed to carry one particle's persistent state between ranks.
    pure integer function particles_record_size(self)
@@ -181,14 +241,18 @@ contains
                     record(2 * d + 3:2 * d + 2 + s), nint(record(2 * d + 3 + s)), transfer(record(2 * d + 4 + s), 1_i8))
    end subroutine particles_append_record
 
-   !> Append one particle given its persistent state.
+   !> Append one particle given its persistent state (dropped if the arrays cannot grow: see allocation).
    subroutine particles_add(self, x, v, mass, density, sbar, material, id)
       class(particle_set_t), intent(inout) :: self
       real(rp), intent(in) :: x(:), v(:), mass, density, sbar(:)
       integer, intent(in) :: material
       integer(i8), intent(in) :: id
       integer :: p
-      if (self%count == size(self%mass)) call self%reserve(max(16, self%count + self%count / 2))
+      if (.not. self%allocation%ok) return      ! no memory: the run stops at the end of the step
+      if (self%count == size(self%mass)) then
+         call self%reserve(max(16, self%count + self%count / 2))
+         if (.not. self%allocation%ok) return
+      end if
       p = self%count + 1
       self%count = p
       self%x(:, p) = x

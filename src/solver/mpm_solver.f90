@@ -42,6 +42,7 @@ module mpm_solver
    use active_region, only: scene_extent, particle_extent, cells_of_extent, guard_cells, box_needs_change, target_box, &
                             slack_cells
    use status_broadcast, only: agree_on_status
+   use input_text, only: int_text
    use phase_timers, only: phase_timers_t, phase_particles_to_grid, phase_grid_update, phase_walls, &
                            phase_stabilization, phase_grid_to_particles, phase_constitutive, phase_inflow, &
                            phase_halo, phase_migration, phase_sort, phase_time_step, phase_volume_correction, &
@@ -85,6 +86,7 @@ module mpm_solver
       procedure :: balance_load => solver_balance_load
       procedure :: set_layout => solver_set_layout
       procedure :: cover_particles => solver_cover_particles
+      procedure :: check_particle_memory => solver_check_particle_memory
       procedure :: free => solver_free
    end type solver_t
 
@@ -122,7 +124,7 @@ contains
       call target_box(need_lo, need_hi, guard_cells(1.0_rp) + slack_cells, grid_cells, dim, box_lo, box_hi)
       call self%domain%init(comm, dim, grid_cells, status, box_lo, box_hi)
       if (.not. status%ok) return
-      call self%grid%init(self%domain, grid_origin, scene%grid%cell_size, frame)
+      call self%grid%init(self%domain, grid_origin, scene%grid%cell_size, frame, status)
       call build_materials(scene%materials, self%materials, status)
       if (status%ok) call build_stabilizers(scene%materials, self%schemes, status)
       call self%volume%init(scene, self%gravity)
@@ -137,6 +139,8 @@ contains
       seed = .true.
       if (present(seed_particles)) seed = seed_particles
       if (seed) call seed_bodies(scene, self%grid, self%domain, self%particles)
+      call self%check_particle_memory(status)
+      if (.not. status%ok) return
       call update_cells(self%grid, self%particles)
       call sort_by_material_and_cell(self%grid, self%particles)
       call size_node_arrays(self)
@@ -156,6 +160,16 @@ contains
       ! the bodies' momentum at t = 0 starts their force series (a restart reads it from the checkpoint)
       if (seed) call self%bodies%start(self%bodies%measure(self%particles, self%grid%frame, self%domain%comm))
    end subroutine solver_init
+
+   !> Fail on every rank if the particle arrays of some rank could not grow (seeding, inflow, migration):
+   !> the message of the lowest such rank. Collective.
+   subroutine solver_check_particle_memory(self, status)
+      class(solver_t), intent(in) :: self
+      type(status_t), intent(inout) :: status
+      if (.not. self%particles%allocation%ok) &
+         call status%fail('rank '//int_text(self%domain%rank)//': '//trim(self%particles%allocation%message))
+      call agree_on_status(status, self%domain%comm)
+   end subroutine solver_check_particle_memory
 
    !> The walls (with their local nodes) and the inlets (with their feeder walls) of the scene.
    subroutine build_boundaries(self)
@@ -217,7 +231,9 @@ contains
          call redistribute_particles(self%domain, self%grid, self%particles, status)
          if (.not. status%ok) return
       end if
-      call self%grid%init(self%domain, self%grid%origin, self%grid%h, self%grid%frame)
+      call self%grid%init(self%domain, self%grid%origin, self%grid%h, self%grid%frame, status)
+      call agree_on_status(status, self%domain%comm)
+      if (.not. status%ok) return
       call build_boundaries(self)
       call self%volume%reset_grid()
       call update_cells(self%grid, self%particles)

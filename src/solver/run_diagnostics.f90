@@ -4,6 +4,7 @@ module run_diagnostics
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_INTEGER8, MPI_SUM, MPI_MAX
    use particle_set, only: particle_set_t
    use material_model, only: material_slot_t
+   use input_text, only: real_text
    implicit none
    private
 
@@ -68,15 +69,16 @@ contains
              'lost_particles,wall_corrections,max_rank_share'
    end function diagnostics_header
 
-   !> One CSV row; reals in full precision (g0) so rows can be compared to round-off.
+   !> One CSV row; reals in full precision (g0) so rows can be compared to round-off. The time in the
+   !> fewest digits that read back exactly: an output time k x interval prints as 0.3, not 0.30000000000000000.
    function diagnostics_row(diag) result(line)
       type(diagnostics_t), intent(in) :: diag
       character(len=:), allocatable :: line
       character(len=512) :: buffer
-      write (buffer, '(g0,",",i0,",",g0,",",i0,5(",",g0),2(",",i0),",",g0)') &
-         diag%time, diag%step, diag%dt, diag%particles, diag%total_mass, diag%kinetic_energy, &
+      write (buffer, '(i0,",",g0,",",i0,5(",",g0),2(",",i0),",",g0)') &
+         diag%step, diag%dt, diag%particles, diag%total_mass, diag%kinetic_energy, &
          diag%fluid_volume, diag%h_eq, diag%max_speed, diag%lost_particles, diag%wall_corrections, &
          diag%max_rank_share
-      line = trim(adjustl(buffer))
+      line = real_text(diag%time)//','//trim(adjustl(buffer))
    end function diagnostics_row
 end module run_diagnostics
