@@ -1,8 +1,9 @@
 !> Flotsam driver: `mpirun -np N flotsam scene.nml [override.nml ...] [--set '<namelist text>' ...]
-!> [--overwrite] [--restart <checkpoint>|latest]`, or `flotsam --version`. Overrides apply in
-!> command-line order. The only place that touches MPI_COMM_WORLD and the only place that stops the
-!> program. A run starts its standard error with a banner (version, commit, ranks, scene, output
-!> folder) and ends it with one line of outcome and cost (run_summary), so a batch log shows what ran.
+!> [--overwrite] [--restart <checkpoint>|latest [--allow-scene-change]]`, or `flotsam --version`.
+!> Overrides apply in command-line order. The only place that touches MPI_COMM_WORLD and the only
+!> place that stops the program. A run starts its standard error with a banner (version, commit,
+!> ranks, scene, output folder) and ends it with one line of outcome and cost (run_summary), so a
+!> batch log shows what ran.
 !>
 !> Exit codes: 0 done; 2 scene, set-up or checkpoint refused; 3 output folder; 4 failure during the
 !> run (including a blow-up); 5 stopped by SIGTERM/SIGINT after writing a checkpoint.
@@ -30,9 +31,9 @@ program flotsam
    type(status_t) :: status
    type(solver_t) :: solver
    type(run_progress_t) :: progress
-   character(len=:), allocatable :: scene_path, restart_path
+   character(len=:), allocatable :: scene_path, restart_path, scene_warning
    type(scene_override_t), allocatable :: overrides(:)
-   logical :: overwrite
+   logical :: overwrite, allow_scene_change = .false.
    integer :: rank, exit_code, stopped_by
 
    call prefer_romio()     ! before MPI_Init: see src/domain/mpi_io_choice.f90
@@ -57,9 +58,10 @@ program flotsam
       call prepare_restart_directory(scene%run%output_dir, MPI_COMM_WORLD, status)
       if (.not. status%ok) call fail(status, exit_output_folder)
       call resolve_restart_path(restart_path, status)
-      call read_checkpoint(restart_path, scene, solver, progress, status)
+      call read_checkpoint(restart_path, scene, solver, progress, status, allow_scene_change, scene_warning)
       if (.not. status%ok) call fail(status, exit_scene)
       call print_banner()
+      if (rank == 0 .and. len(scene_warning) > 0) write (error_unit, '(a)') 'flotsam: warning: '//scene_warning
       if (rank == 0) write (error_unit, '(a,i0,a)') 'flotsam: continuing '//restart_path//' from step ', &
          solver%step, ' (t = '//real_text(solver%time)//' s)'
    end if
@@ -122,6 +124,8 @@ contains
             return
          case ('--overwrite')
             overwrite = .true.
+         case ('--allow-scene-change')
+            allow_scene_change = .true.
          case ('--restart')
             restart_follows = .true.
             restart_given = .true.
@@ -152,6 +156,10 @@ contains
          exit_code = exit_scene
       else if (len(path) == 0) then
          if (rank == 0) call print_usage(error_unit)
+         exit_code = exit_scene
+      else if (allow_scene_change .and. len(restart) == 0) then
+         if (rank == 0) write (error_unit, '(a)') 'flotsam: error: --allow-scene-change applies to a restart only '// &
+            '(--restart <checkpoint>)'
          exit_code = exit_scene
       else if (len(restart) > 0 .and. overwrite) then
          if (rank == 0) write (error_unit, '(a)') 'flotsam: error: --restart continues a run; it cannot be '// &
@@ -201,7 +209,7 @@ contains
    subroutine print_usage(unit)
       integer, intent(in) :: unit
       write (unit, '(a)') 'usage: mpirun -np N flotsam <scene.nml> [override.nml ...] [--set <text> ...]', &
-         '                                 [--overwrite] [--restart <checkpoint>]', &
+         '                                 [--overwrite] [--restart <checkpoint> [--allow-scene-change]]', &
          '  <scene.nml>               scene file of Fortran namelists (see docs/input.md)', &
          '  override.nml              namelist file applied on top of the scene (in order)', &
          "  --set '<namelist text>'   the same, inline: --set '&grid rotation = 45 /'", &
@@ -210,6 +218,8 @@ contains
          '  --restart <checkpoint>    continue the run from a checkpoint file of its output folder;', &
          '                            --restart latest takes the newest one (see docs/output.md)', &
          '  --version                 print the version, git commit, build type, MPI and HDF5 libraries', &
+         '  --allow-scene-change      with --restart: continue although the scene changes more than', &
+         '                            end_time and the output and checkpoint settings (a warning lists it)', &
          '  -h, --help                print this text', &
          'exit codes: 0 done, 2 scene or checkpoint refused, 3 output folder, 4 run failed,', &
          '            5 stopped by SIGTERM/SIGINT (a checkpoint was written)'

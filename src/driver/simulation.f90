@@ -8,7 +8,8 @@
 !>
 !> After every step the ranks agree, in one small reduction, on four flags: an unhealthy particle
 !> somewhere, a termination signal received somewhere, (rank 0's clock) a wall-time checkpoint
-!> being due, and particle arrays that could not grow (out of memory) somewhere. All ranks therefore take the same branch in the same step.
+!> being due, and particle arrays that could not grow (out of memory) somewhere. All ranks therefore
+!> take the same branch in the same step.
 module simulation
    use kinds, only: rp, i8, name_len
    use mpi_f08, only: MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER, MPI_MAX
@@ -43,6 +44,21 @@ module simulation
    !> Positions of the flags agreed on after every step.
    integer, parameter :: flag_unhealthy = 1, flag_signal = 2, flag_wall_checkpoint = 3, flag_no_memory = 4
 
+   !> What the time loop keeps from step to step besides the solver and the run's progress.
+   type :: time_loop_t
+      type(csv_writer_t) :: csv                   !< diagnostics.csv (rank 0)
+      type(load_records_t) :: records             !< loads.csv, gauges.csv, bodies.csv
+      type(progress_reporter_t) :: reporter       !< progress lines and the wall clock
+      type(diagnostics_t) :: diag                 !< the latest diagnostics row
+      character(len=:), allocatable :: dir        !< the output folder
+      character(len=:), allocatable :: checkpoint_path   !< the latest checkpoint written
+      character(len=:), allocatable :: outcome    !< run_summary.csv: finished, blew_up, ...
+      real(rp) :: end_time = 0.0_rp, interval = 0.0_rp   !< &run end_time and output_interval [s]
+      real(rp) :: speed_limit = 0.0_rp, density_limits(2) = 0.0_rp   !< blow-up limits
+      real(rp) :: last_checkpoint_wall = 0.0_rp   !< reporter's clock at the latest checkpoint [s]
+      integer(i8) :: last_checkpoint_step = 0, first_step = 0, particle_steps = 0
+   end type time_loop_t
+
 contains
 
    !> Run `solver` to its end time (or max_steps), writing into the output folder. `progress` is the
@@ -54,164 +70,205 @@ contains
       type(run_progress_t), intent(inout) :: progress
       type(status_t), intent(inout) :: status
       integer, intent(out) :: stopped_by
-      type(csv_writer_t) :: csv
-      type(load_records_t) :: records
-      type(progress_reporter_t) :: reporter
-      type(diagnostics_t) :: diag
-      character(len=:), allocatable :: dir, checkpoint_path
-      real(rp) :: end_time, interval, speed_limit, last_checkpoint_wall, density_limits(2)
+      type(time_loop_t) :: loop
       integer :: flags(4)
-      integer(i8) :: last_checkpoint_step, first_step, particle_steps
-      logical :: at_output, checkpoint_due, landing
-      character(len=:), allocatable :: outcome
 
       stopped_by = 0
-      dir = trim(solver%run%output_dir)
-      end_time = solver%run%end_time
-      interval = solver%run%output_interval
-      speed_limit = blow_up_speed(solver)
-      density_limits = blow_up_densities(solver)
-      call open_diagnostics(solver, progress, csv, status)
+      call start_run(solver, progress, loop, status)
       if (.not. status%ok) return
-      call records%open(solver, progress, status)
-      if (.not. status%ok) then
-         call csv%close()
-         call records%close()
-         return
-      end if
-
-      ! a restart continues in the checkpoint's layout (read_checkpoint); a new run starts balanced
-      if (.not. progress%restarted) call solver%balance_load(status)
-      if (.not. status%ok) then
-         call csv%close()
-         return
-      end if
-      diag = solver%diagnostics()
-      if (progress%restarted) then
-         progress%next_output_index = output_index_of(progress%next_output_time, interval, end_time)
-         call write_xdmf(solver, progress, status)
-      else
-         if (solver%domain%rank == 0) call csv%write_row(diagnostics_row(diag))
-         call write_output(solver, progress, status)
-         progress%next_output_index = 1
-         progress%next_output_time = scheduled_output_time(progress%next_output_index, interval, end_time)
-      end if
-      call agree_on_status(status, solver%domain%comm)
-      if (.not. status%ok) then
-         call csv%close()
-         return
-      end if
-      call install_termination_handlers()
-      call reporter%start(solver%run%progress_interval, solver%time, end_time)
-      last_checkpoint_wall = reporter%elapsed()
-      last_checkpoint_step = solver%step
-      first_step = solver%step
-      particle_steps = 0
-      outcome = 'finished'
-      call solver%timers%reset()
-      call solver%timers%switch_to(phase_other)
-
-      do while (solver%time < end_time * (1.0_rp - 1.0e-12_rp) .and. solver%step < solver%run%max_steps)
-         ! land exactly on the next output time (time + (next - time) may miss it by one ulp)
-         landing = solver%time + solver%dt * (1.0_rp + 1.0e-9_rp) >= progress%next_output_time
-         if (landing) solver%dt = progress%next_output_time - solver%time
-         particle_steps = particle_steps + solver%particles%count
-         call solver%advance()
-         if (landing) solver%time = progress%next_output_time
-         call reporter%update(solver%time, solver%step, diag%particles, solver%domain%rank == 0)
-
-         call solver%timers%switch_to(phase_health)
-         flags = 0
-         if (.not. particles_healthy(solver%particles, speed_limit, density_limits)) flags(flag_unhealthy) = 1
-         flags(flag_signal) = received_termination_signal()
-         if (.not. solver%particles%allocation%ok) flags(flag_no_memory) = 1
-         if (solver%domain%rank == 0 .and. solver%run%checkpoint_interval_wall > 0.0_rp) then
-            if (reporter%elapsed() - last_checkpoint_wall >= solver%run%checkpoint_interval_wall) &
-               flags(flag_wall_checkpoint) = 1
-         end if
-         call MPI_Allreduce(MPI_IN_PLACE, flags, size(flags), MPI_INTEGER, MPI_MAX, solver%domain%comm)
-         call solver%timers%switch_to(phase_other)
-
+      do while (solver%time < loop%end_time * (1.0_rp - 1.0e-12_rp) .and. solver%step < solver%run%max_steps)
+         call take_step(solver, progress, loop, flags)
          ! particles that found no room (inflow, migration): the state is incomplete, stop before reading it
          if (flags(flag_no_memory) > 0) then
             call solver%check_particle_memory(status)
             exit
          end if
          if (flags(flag_unhealthy) > 0) then
-            call report_blow_up(solver, progress, speed_limit, density_limits, status)
-            outcome = 'blew_up'
+            call report_blow_up(solver, progress, loop%speed_limit, loop%density_limits, status)
+            loop%outcome = 'blew_up'
             exit
          end if
          ! loads, gauges and bodies: before a checkpoint of this step, which then holds the next interval's start
-         if (records%due(solver)) then
+         if (loop%records%due(solver)) then
             call solver%timers%switch_to(phase_loads)
-            call records%write_rows(solver)
+            call loop%records%write_rows(solver)
             call solver%timers%switch_to(phase_other)
          end if
-
-         at_output = solver%time >= progress%next_output_time * (1.0_rp - 1.0e-12_rp) .or. &
-                     solver%step >= solver%run%max_steps
-         ! between steps, and before an output so that its shares are balanced ones
-         if (at_output .or. mod(solver%step, int(solver%run%rebalance_interval, i8)) == 0) then
-            call solver%timers%switch_to(phase_rebalance)
-            call solver%balance_load(status)
-            call solver%timers%switch_to(phase_other)
-            if (.not. status%ok) exit
-         end if
-         if (at_output) then
-            call solver%timers%switch_to(phase_diagnostics)
-            diag = solver%diagnostics()
-            if (solver%domain%rank == 0) call csv%write_row(diagnostics_row(diag))
-            call solver%timers%switch_to(phase_output)
-            call write_output(solver, progress, status)
-            call solver%timers%switch_to(phase_other)
-            if (.not. status%ok) exit
-            ! an output forced by max_steps before the output time keeps the schedule: a run continued
-            ! from its checkpoint must still land on the output time it had not reached
-            if (solver%time >= progress%next_output_time * (1.0_rp - 1.0e-12_rp)) then
-               progress%next_output_index = progress%next_output_index + 1
-               progress%next_output_time = scheduled_output_time(progress%next_output_index, interval, end_time)
-            end if
-         end if
-
-         checkpoint_due = flags(flag_signal) > 0 .or. flags(flag_wall_checkpoint) > 0
-         if (solver%run%checkpoint_interval_steps > 0) &
-            checkpoint_due = checkpoint_due .or. mod(solver%step, solver%run%checkpoint_interval_steps) == 0
-         if (checkpoint_due) then
-            call solver%timers%switch_to(phase_checkpoint)
-            call write_checkpoint(solver, progress, dir, solver%run%checkpoints_kept, checkpoint_path, status)
-            call solver%timers%switch_to(phase_other)
-            if (.not. status%ok) exit
-            last_checkpoint_wall = reporter%elapsed()
-            last_checkpoint_step = solver%step
-         end if
+         call output_if_due(solver, progress, loop, status)
+         if (.not. status%ok) exit
+         call checkpoint_if_due(solver, progress, loop, flags, status)
+         if (.not. status%ok) exit
          if (flags(flag_signal) > 0) then
             stopped_by = flags(flag_signal)
-            outcome = 'stopped_by_signal'
+            loop%outcome = 'stopped_by_signal'
             call status%fail('stopped by '//signal_name(stopped_by)//' at step '//int_text(solver%step)//' (t = '// &
-                             real_text(solver%time)//' s); checkpoint written: '//checkpoint_path// &
-                             '; continue with --restart '//checkpoint_path)
+                             real_text(solver%time)//' s); checkpoint written: '//loop%checkpoint_path// &
+                             '; continue with --restart '//loop%checkpoint_path)
             exit
          end if
       end do
-
-      ! the final state, unless the loop just saved it (or failed)
-      call solver%timers%switch_to(phase_checkpoint)
-      if (status%ok .and. last_checkpoint_step /= solver%step) &
-         call write_checkpoint(solver, progress, dir, solver%run%checkpoints_kept, checkpoint_path, status)
-      call csv%close()
-      call records%close()
-      call solver%timers%switch_to(phase_other)
-      if (.not. status%ok .and. outcome == 'finished') outcome = 'failed'
-      if (outcome == 'finished' .and. solver%time < end_time * (1.0_rp - 1.0e-12_rp)) outcome = 'max_steps'
-      block
-         type(status_t) :: summary_status     ! a summary that cannot be written must not hide the run's own status
-         call write_run_summary(dir, solver%domain%comm, reporter%elapsed(), solver%step - first_step, &
-                                particle_steps, outcome, solver%time, summary_status)
-         call write_timing(dir, solver%domain%comm, solver%timers%seconds, phase_names, summary_status)
-         if (status%ok .and. .not. summary_status%ok) status = summary_status
-      end block
+      call finish_run(solver, progress, loop, status)
    end subroutine run_simulation
+
+   !> Open diagnostics.csv and the load records, balance a new run and write its output at the start
+   !> time (a restart has its outputs up to the checkpoint: only the XDMF files are rewritten), then start
+   !> the clocks. Collective; on failure the files are closed again.
+   subroutine start_run(solver, progress, loop, status)
+      type(solver_t), intent(inout) :: solver
+      type(run_progress_t), intent(inout) :: progress
+      type(time_loop_t), intent(inout) :: loop
+      type(status_t), intent(inout) :: status
+
+      loop%dir = trim(solver%run%output_dir)
+      loop%end_time = solver%run%end_time
+      loop%interval = solver%run%output_interval
+      loop%speed_limit = blow_up_speed(solver)
+      loop%density_limits = blow_up_densities(solver)
+      call open_diagnostics(solver, progress, loop%csv, status)
+      if (.not. status%ok) return
+      call loop%records%open(solver, progress, status)
+      ! a restart continues in the checkpoint's layout (read_checkpoint); a new run starts balanced
+      if (status%ok .and. .not. progress%restarted) call solver%balance_load(status)
+      if (.not. status%ok) then
+         call loop%csv%close()
+         call loop%records%close()
+         return
+      end if
+      loop%diag = solver%diagnostics()
+      if (progress%restarted) then
+         progress%next_output_index = output_index_of(progress%next_output_time, loop%interval, loop%end_time)
+         call write_xdmf(solver, progress, status)
+      else
+         if (solver%domain%rank == 0) call loop%csv%write_row(diagnostics_row(loop%diag))
+         call write_output(solver, progress, status)
+         progress%next_output_index = 1
+         progress%next_output_time = scheduled_output_time(progress%next_output_index, loop%interval, loop%end_time)
+      end if
+      call agree_on_status(status, solver%domain%comm)
+      if (.not. status%ok) then
+         call loop%csv%close()
+         call loop%records%close()
+         return
+      end if
+      call install_termination_handlers()
+      call loop%reporter%start(solver%run%progress_interval, solver%time, loop%end_time)
+      loop%last_checkpoint_wall = loop%reporter%elapsed()
+      loop%last_checkpoint_step = solver%step
+      loop%first_step = solver%step
+      loop%particle_steps = 0
+      loop%outcome = 'finished'
+      call solver%timers%reset()
+      call solver%timers%switch_to(phase_other)
+   end subroutine start_run
+
+   !> One step, shortened to land exactly on the next output time, then the flags all ranks agree on
+   !> (one small reduction): an unhealthy particle, a termination signal, a wall-time checkpoint due.
+   subroutine take_step(solver, progress, loop, flags)
+      type(solver_t), intent(inout) :: solver
+      type(run_progress_t), intent(in) :: progress
+      type(time_loop_t), intent(inout) :: loop
+      integer, intent(out) :: flags(4)
+      logical :: landing
+
+      ! land exactly on the next output time (time + (next - time) may miss it by one ulp)
+      landing = solver%time + solver%dt * (1.0_rp + 1.0e-9_rp) >= progress%next_output_time
+      if (landing) solver%dt = progress%next_output_time - solver%time
+      loop%particle_steps = loop%particle_steps + solver%particles%count
+      call solver%advance()
+      if (landing) solver%time = progress%next_output_time
+      call loop%reporter%update(solver%time, solver%step, loop%diag%particles, solver%domain%rank == 0)
+
+      call solver%timers%switch_to(phase_health)
+      flags = 0
+      if (.not. particles_healthy(solver%particles, loop%speed_limit, loop%density_limits)) flags(flag_unhealthy) = 1
+      flags(flag_signal) = received_termination_signal()
+      if (.not. solver%particles%allocation%ok) flags(flag_no_memory) = 1
+      if (solver%domain%rank == 0 .and. solver%run%checkpoint_interval_wall > 0.0_rp) then
+         if (loop%reporter%elapsed() - loop%last_checkpoint_wall >= solver%run%checkpoint_interval_wall) &
+            flags(flag_wall_checkpoint) = 1
+      end if
+      call MPI_Allreduce(MPI_IN_PLACE, flags, size(flags), MPI_INTEGER, MPI_MAX, solver%domain%comm)
+      call solver%timers%switch_to(phase_other)
+   end subroutine take_step
+
+   !> At an output time (or the last step of max_steps): rebalance, a diagnostics row and the fields;
+   !> between outputs the periodic balance check. Collective.
+   subroutine output_if_due(solver, progress, loop, status)
+      type(solver_t), intent(inout) :: solver
+      type(run_progress_t), intent(inout) :: progress
+      type(time_loop_t), intent(inout) :: loop
+      type(status_t), intent(inout) :: status
+      logical :: at_output
+
+      at_output = solver%time >= progress%next_output_time * (1.0_rp - 1.0e-12_rp) .or. &
+                  solver%step >= solver%run%max_steps
+      ! between steps, and before an output so that its shares are balanced ones
+      if (at_output .or. mod(solver%step, int(solver%run%rebalance_interval, i8)) == 0) then
+         call solver%timers%switch_to(phase_rebalance)
+         call solver%balance_load(status)
+         call solver%timers%switch_to(phase_other)
+         if (.not. status%ok) return
+      end if
+      if (.not. at_output) return
+      call solver%timers%switch_to(phase_diagnostics)
+      loop%diag = solver%diagnostics()
+      if (solver%domain%rank == 0) call loop%csv%write_row(diagnostics_row(loop%diag))
+      call solver%timers%switch_to(phase_output)
+      call write_output(solver, progress, status)
+      call solver%timers%switch_to(phase_other)
+      if (.not. status%ok) return
+      ! an output forced by max_steps before the output time keeps the schedule: a run continued
+      ! from its checkpoint must still land on the output time it had not reached
+      if (solver%time >= progress%next_output_time * (1.0_rp - 1.0e-12_rp)) then
+         progress%next_output_index = progress%next_output_index + 1
+         progress%next_output_time = scheduled_output_time(progress%next_output_index, loop%interval, loop%end_time)
+      end if
+   end subroutine output_if_due
+
+   !> A checkpoint when a signal arrived, the wall-time interval has passed or the step is a multiple of
+   !> checkpoint_interval_steps. Collective.
+   subroutine checkpoint_if_due(solver, progress, loop, flags, status)
+      type(solver_t), intent(inout) :: solver
+      type(run_progress_t), intent(inout) :: progress
+      type(time_loop_t), intent(inout) :: loop
+      integer, intent(in) :: flags(4)
+      type(status_t), intent(inout) :: status
+      logical :: checkpoint_due
+
+      checkpoint_due = flags(flag_signal) > 0 .or. flags(flag_wall_checkpoint) > 0
+      if (solver%run%checkpoint_interval_steps > 0) &
+         checkpoint_due = checkpoint_due .or. mod(solver%step, solver%run%checkpoint_interval_steps) == 0
+      if (.not. checkpoint_due) return
+      call solver%timers%switch_to(phase_checkpoint)
+      call write_checkpoint(solver, progress, loop%dir, solver%run%checkpoints_kept, loop%checkpoint_path, status)
+      call solver%timers%switch_to(phase_other)
+      if (.not. status%ok) return
+      loop%last_checkpoint_wall = loop%reporter%elapsed()
+      loop%last_checkpoint_step = solver%step
+   end subroutine checkpoint_if_due
+
+   !> The final checkpoint (unless the loop just wrote it, or failed), close the files, and write
+   !> run_summary.csv and timing.csv. Collective.
+   subroutine finish_run(solver, progress, loop, status)
+      type(solver_t), intent(inout) :: solver
+      type(run_progress_t), intent(inout) :: progress
+      type(time_loop_t), intent(inout) :: loop
+      type(status_t), intent(inout) :: status
+      type(status_t) :: summary_status     ! a summary that cannot be written must not hide the run's own status
+
+      call solver%timers%switch_to(phase_checkpoint)
+      if (status%ok .and. loop%last_checkpoint_step /= solver%step) &
+         call write_checkpoint(solver, progress, loop%dir, solver%run%checkpoints_kept, loop%checkpoint_path, status)
+      call loop%csv%close()
+      call loop%records%close()
+      call solver%timers%switch_to(phase_other)
+      if (.not. status%ok .and. loop%outcome == 'finished') loop%outcome = 'failed'
+      if (loop%outcome == 'finished' .and. solver%time < loop%end_time * (1.0_rp - 1.0e-12_rp)) loop%outcome = 'max_steps'
+      call write_run_summary(loop%dir, solver%domain%comm, loop%reporter%elapsed(), solver%step - loop%first_step, &
+                             loop%particle_steps, loop%outcome, solver%time, summary_status)
+      call write_timing(loop%dir, solver%domain%comm, solver%timers%seconds, phase_names, summary_status)
+      if (status%ok .and. .not. summary_status%ok) status = summary_status
+   end subroutine finish_run
 
    !> The particle speed taken as a blow-up [m/s]: &run speed_limit, or by default 10 times the fastest
    !> wave speed of the materials at their reference density (no physical flow of the scene comes near

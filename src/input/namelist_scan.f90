@@ -10,7 +10,7 @@ module namelist_scan
    implicit none
    private
 
-   public :: scan_namelist_file
+   public :: scan_namelist_file, scan_namelist_text
 
    !> One `designator = values` of a group, comments removed.
    type, public :: namelist_item_t
@@ -138,6 +138,33 @@ contains
       call find_groups(lines(1:nlines), path, known_groups, file, status)
       rewind (unit)
    end subroutine scan_namelist_file
+
+   !> The same scan of namelist text held in memory, lines separated by new_line('a') (e.g. the scene
+   !> stored in a checkpoint); `label` names it in messages.
+   subroutine scan_namelist_text(text, label, known_groups, file, status)
+      character(len=*), intent(in) :: text
+      character(len=*), intent(in) :: label
+      character(len=*), intent(in) :: known_groups(:)
+      type(namelist_file_t), intent(out) :: file
+      type(status_t), intent(inout) :: status
+      type(line_t), allocatable :: lines(:)
+      integer :: start, break, l
+
+      file%path = label
+      allocate (file%groups(0))
+      allocate (lines(count([(text(l:l) == new_line('a'), l = 1, len(text))]) + 1))
+      start = 1
+      do l = 1, size(lines)
+         break = index(text(start:), new_line('a'))
+         if (break == 0) then
+            lines(l)%text = text(start:)
+         else
+            lines(l)%text = text(start:start + break - 2)
+            start = start + break
+         end if
+      end do
+      call find_groups(lines, label, known_groups, file, status)
+   end subroutine scan_namelist_text
 
    subroutine read_lines(unit, path, lines, nlines, status)
       integer, intent(in) :: unit

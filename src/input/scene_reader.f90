@@ -21,7 +21,7 @@ module scene_reader
    implicit none
    private
 
-   public :: read_scene
+   public :: read_scene, group_variables
 
    !> A layer applied on top of the scene file: another namelist file, or namelist text from the command
    !> line (`--set '&grid rotation = 45 /'`). Singleton groups change the variables they assign; a
@@ -37,12 +37,13 @@ module scene_reader
    !> The rank of `comm` that reads the file.
    integer, parameter :: root = 0
 
-   character(len=*), parameter :: known_groups(*) = &
+   !> The namelist groups of a scene file, in the order a resolved scene is written (scene_record).
+   character(len=*), parameter, public :: known_groups(*) = &
       [character(len=9) :: 'run', 'grid', 'box_walls', 'gravity', 'material', 'body', 'wall', 'inlet', 'gauge']
    !> Groups that may appear at most once.
    character(len=*), parameter :: singleton_groups(*) = [character(len=9) :: 'run', 'grid', 'box_walls', 'gravity']
    !> Groups that may appear any number of times, one scene entry each.
-   character(len=*), parameter :: repeated_groups(*) = &
+   character(len=*), parameter, public :: repeated_groups(*) = &
       [character(len=8) :: 'material', 'body', 'wall', 'inlet', 'gauge']
    !> Groups a scene file must contain.
    character(len=*), parameter :: required_groups(*) = [character(len=8) :: 'run', 'grid', 'material']
@@ -649,6 +650,13 @@ contains
       call status%fail(file%path//': line '//int_text(file%groups(g)%first_line)//': group &'//group//label//': '// &
                        trim(message))
    end subroutine report_read_error
+
+   !> The variables of namelist group `group`, in the order of the table above (docs/input.md).
+   pure function group_variables(group) result(names)
+      character(len=*), intent(in) :: group
+      character(len=len(variables%name)), allocatable :: names(:)
+      names = pack(variables%name, variables%group == group)
+   end function group_variables
 
    !> Position of variable `name` of `group` in `variables`; 0 if the group has no such variable.
    pure integer function find_variable(group, name) result(found)

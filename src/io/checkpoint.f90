@@ -11,10 +11,14 @@
 !> redistributed by position over a uniform split of an active box laid out around them, and
 !> re-sorted (equal to round-off).
 !>
+!> It also stores the resolved scene of the run (scene_record): a restart compares it with the scene it
+!> is given and refuses a change of anything but the settings restart_changeable lists
+!> (scene_comparison), unless told to allow it.
+!>
 !> A checkpoint is written as `<name>.tmp`, synced to disk, and renamed only when complete; it carries
-!> a format name and version, and an attribute `complete` written last. Reading checks all of these
-!> and the scene's grid and materials, and reads everything before it changes the solver: a bad file
-!> is refused as a whole.
+!> a format name and version, and an attribute `complete` written last. Reading checks all of these,
+!> the scene's grid and materials and the stored scene, and reads everything before it changes the
+!> solver: a bad file is refused as a whole.
 module checkpoint
    use kinds, only: rp, i8, path_len
    use mpi_f08, only: MPI_Comm_size
@@ -31,14 +35,36 @@ module checkpoint
    use file_system, only: rename_path, remove_file, path_exists
    use status_broadcast, only: agree_on_status, broadcast_status
    use input_text, only: int_text
+   use scene_record, only: namelist_text_t, scene_namelist_groups, scene_namelist_text
+   use scene_comparison, only: scene_change_t, compare_scene_texts, describe_changes
    implicit none
    private
 
    !> Identification of the file format; a reader accepts exactly this version.
    character(len=*), parameter, public :: checkpoint_format = 'flotsam checkpoint'
    !> 2: grid rotation; 3: cuts sized (ranks + 1) x 3 for any rank grid (load balancing); their ends, the
-   !> active box, need not be the grid's (a version-3 file of the whole grid is read the same way)
-   integer, parameter, public :: checkpoint_format_version = 4
+   !> active box, need not be the grid's (a version-3 file of the whole grid is read the same way);
+   !> 4: the state of the load series; 5: the resolved scene (scene_group_<k>)
+   integer, parameter, public :: checkpoint_format_version = 5
+   !> The previous version: the same layout without the scene, read only with --allow-scene-change.
+   integer, parameter :: unscened_format_version = 4
+   !> Longest text of one group of the stored scene read back.
+   integer, parameter :: group_text_len = 16384
+
+   !> What a checkpoint holds for this rank, read in full before any of it is adopted.
+   type :: saved_state_t
+      real(rp) :: time = 0.0_rp, dt = 0.0_rp, mass_tolerance = 0.0_rp, next_output_time = 0.0_rp
+      integer(i8) :: step = 0
+      integer(i8) :: total = 0                    !< particles written
+      integer :: ranks_written = 1
+      integer(i8), allocatable :: rank_counts(:), lost(:), corrections(:)   !< per rank written
+      logical :: same_decomposition = .false.     !< written on as many ranks as read: cuts holds its layout
+      integer, allocatable :: cuts(:)
+      integer :: n = 0                            !< particles this rank read
+      real(rp), allocatable :: x(:, :), v(:, :), mass(:), density(:), sbar(:, :)
+      integer, allocatable :: material(:)
+      integer(i8), allocatable :: id(:)
+   end type saved_state_t
 
    public :: write_checkpoint, read_checkpoint, latest_checkpoint_path
 
@@ -78,6 +104,7 @@ contains
       call file%write_attribute('dt', solver%dt, status)
       call file%write_attribute('mass_tolerance', solver%mass_tolerance, status)
       call file%write_attribute('next_output_time', progress%next_output_time, status)
+      call write_scene_text(solver%scene, file, status)
       call write_particles(solver, file, status)
       call write_series_state(solver, file, status)      ! after write_particles: it made the group ranks
       call write_outputs(solver, progress, file, status)
@@ -209,27 +236,27 @@ contains
 
    !> Restore the solver's state and the run's progress from checkpoint `path` for `scene`. The solver
    !> must be set up for the scene without particles (solver%init(..., seed_particles=.false.)).
-   !> Nothing is changed unless the whole file was read and accepted. Collective.
-   subroutine read_checkpoint(path, scene, solver, progress, status)
+   !> Nothing is changed unless the whole file was read and accepted. A scene that differs from the
+   !> stored one in more than restart_changeable is refused, unless `allow_scene_change`; then
+   !> `scene_warning` lists the differences ('' when there are none). Collective.
+   subroutine read_checkpoint(path, scene, solver, progress, status, allow_scene_change, scene_warning)
       character(len=*), intent(in) :: path
       type(scene_t), intent(in) :: scene
       type(solver_t), intent(inout) :: solver
       type(run_progress_t), intent(out) :: progress
       type(status_t), intent(inout) :: status
+      logical, intent(in), optional :: allow_scene_change
+      character(len=:), allocatable, intent(out), optional :: scene_warning
       type(hdf5_file_t) :: file
-      type(slab_t) :: slab, all_ranks
-      character(len=64) :: text
-      integer :: version, complete, ranks_written, n, rank, n_ranks, p
-      integer(i8) :: total, step
-      integer(i8), allocatable :: rank_counts(:), lost(:), corrections(:)
-      integer, allocatable :: cuts(:)
-      logical :: same_decomposition
-      real(rp) :: time, dt, mass_tolerance, next_output_time
-      real(rp), allocatable :: x(:, :), v(:, :), mass(:), density(:), sbar(:, :)
-      integer, allocatable :: material(:)
-      integer(i8), allocatable :: id(:)
-      character(len=:), allocatable :: where
+      type(saved_state_t) :: state
+      type(slab_t) :: all_ranks
+      character(len=:), allocatable :: where, warning
+      logical :: allow
+      integer :: version
 
+      allow = .false.
+      if (present(allow_scene_change)) allow = allow_scene_change
+      warning = ''
       where = 'checkpoint '//trim(path)
       call file%open(path, solver%domain%comm, status)
       if (.not. status%ok) then
@@ -237,125 +264,247 @@ contains
          call status%fail('cannot open '//where//': missing, truncated or not an HDF5 file')
          return
       end if
-      text = ''
-      version = -1
-      complete = 0
-      call file%read_attribute('format', text, status)
-      if (status%ok .and. text /= checkpoint_format) call status%fail(where//' is not a Flotsam checkpoint')
-      call file%read_attribute('format_version', version, status)
-      if (status%ok .and. version /= checkpoint_format_version) then
-         call status%fail(where//' has format version '//int_text(version)//'; this build of flotsam reads version '// &
-                          int_text(checkpoint_format_version))
-      end if
-      call file%read_attribute('complete', complete, status)
-      if (status%ok .and. complete /= 1) call status%fail(where//' is incomplete')
+      call check_format(file, where, version, status)
       call check_scene(file, scene, where, status)
-
-      time = 0.0_rp
-      dt = 0.0_rp
-      mass_tolerance = 0.0_rp
-      next_output_time = 0.0_rp
-      step = 0
-      total = 0
-      ranks_written = 1
-      call file%read_attribute('time', time, status)
-      call file%read_attribute('step', step, status)
-      call file%read_attribute('dt', dt, status)
-      call file%read_attribute('mass_tolerance', mass_tolerance, status)
-      call file%read_attribute('next_output_time', next_output_time, status)
-      call file%read_attribute('sequence', progress%checkpoints_written, status)
-      call file%read_attribute('ranks', ranks_written, status)
-      call file%read_attribute('particles', total, status)
-      if (status%ok .and. (ranks_written < 1 .or. total < 0)) call status%fail(where//' has invalid counts')
+      call check_scene_changes(file, version, scene, where, allow, warning, status)
+      if (present(scene_warning)) scene_warning = warning
+      call read_counts(file, where, state, progress, status)
+      if (status%ok) call read_rank_tables(file, where, state, all_ranks, status)
       if (.not. status%ok) then
          call file%close(status)
          return
       end if
-
-      ! which particles this rank reads: its own slab on the same number of ranks, an even share otherwise
-      rank = solver%domain%rank
-      call MPI_Comm_size(solver%domain%comm, n_ranks)
-      allocate (rank_counts(ranks_written), lost(ranks_written), corrections(ranks_written))
-      all_ranks = slab_t(0, ranks_written, ranks_written)
-      call file%read_slab('ranks/particles', all_ranks, rank_counts, status)
-      call file%read_slab('ranks/lost_particles', all_ranks, lost, status)
-      call file%read_slab('ranks/wall_corrections', all_ranks, corrections, status)
-      if (status%ok .and. sum(rank_counts) /= total) call status%fail(where//' has inconsistent particle counts')
-      if (.not. status%ok) then
-         call file%close(status)
-         return
-      end if
-      ! the same number of ranks: continue in the writer's decomposition (rebalanced or not), each rank
-      ! with the slab it wrote (ranks keep their numbers in any rank grid)
-      same_decomposition = ranks_written == n_ranks
-      if (same_decomposition) then
-         allocate (cuts(size(solver%domain%cuts)))
-         call file%read_attribute('cuts', cuts, status)
-         if (status%ok) then
-            if (.not. valid_layout(reshape(cuts, shape(solver%domain%cuts)), solver%domain%global_cells, &
-                                   solver%domain%dim, n_ranks)) call status%fail(where//' has an invalid decomposition')
-         end if
-      end if
-      if (same_decomposition) then
-         slab = slab_t(sum(rank_counts(1:rank)), rank_counts(rank + 1), total)
-      else
-         slab = even_slab(total, rank, n_ranks)
-      end if
-      n = int(slab%count)
-      allocate (x(scene%grid%dim, max(n, 1)), v(scene%grid%dim, max(n, 1)), mass(max(n, 1)), density(max(n, 1)), &
-                sbar(solver%particles%n_sigma, max(n, 1)), material(max(n, 1)), id(max(n, 1)))
-      call file%read_slab('particles/x', slab, x, status)
-      call file%read_slab('particles/v', slab, v, status)
-      call file%read_slab('particles/mass', slab, mass, status)
-      call file%read_slab('particles/density', slab, density, status)
-      call file%read_slab('particles/sbar', slab, sbar, status)
-      call file%read_slab('particles/material', slab, material, status)
-      call file%read_slab('particles/id', slab, id, status)
+      call read_particles(file, solver, scene, where, state, status)
       call read_outputs(file, progress, status)
-      call read_series_state(solver, file, all_ranks, ranks_written == n_ranks, status)
-      if (status%ok .and. n > 0) then
-         if (any(material(1:n) < 1 .or. material(1:n) > size(solver%materials))) &
+      call read_series_state(solver, file, all_ranks, state%same_decomposition, status)
+      if (status%ok .and. state%n > 0) then
+         if (any(state%material(1:state%n) < 1 .or. state%material(1:state%n) > size(solver%materials))) &
             call status%fail(where//' holds a particle of an unknown material')
       end if
       call file%close(status)
       call agree_on_status(status, solver%domain%comm)
       if (.not. status%ok) return
 
-      ! accepted: adopt the state
-      if (same_decomposition) then
-         call solver%set_layout(reshape(cuts, shape(solver%domain%cuts)), status)
+      call adopt_state(state, scene, where, solver, status)
+      if (.not. status%ok) return
+      progress%next_output_time = state%next_output_time
+      progress%restarted = .true.
+      progress%restart_step = state%step
+   end subroutine read_checkpoint
+
+   !> The format name and version and the mark of a complete file. Version 4 (no stored scene) is
+   !> still read; check_scene_changes decides what to do with it.
+   subroutine check_format(file, where, version, status)
+      type(hdf5_file_t), intent(in) :: file
+      character(len=*), intent(in) :: where
+      integer, intent(out) :: version
+      type(status_t), intent(inout) :: status
+      character(len=64) :: text
+      integer :: complete
+      text = ''
+      version = -1
+      complete = 0
+      call file%read_attribute('format', text, status)
+      if (status%ok .and. text /= checkpoint_format) call status%fail(where//' is not a Flotsam checkpoint')
+      call file%read_attribute('format_version', version, status)
+      if (status%ok .and. version /= checkpoint_format_version .and. version /= unscened_format_version) then
+         call status%fail(where//' has format version '//int_text(version)//'; this build of flotsam reads version '// &
+                          int_text(checkpoint_format_version))
+      end if
+      call file%read_attribute('complete', complete, status)
+      if (status%ok .and. complete /= 1) call status%fail(where//' is incomplete')
+   end subroutine check_format
+
+   !> Time, step, dt and the other scalars, and the counts of ranks and particles written.
+   subroutine read_counts(file, where, state, progress, status)
+      type(hdf5_file_t), intent(in) :: file
+      character(len=*), intent(in) :: where
+      type(saved_state_t), intent(inout) :: state
+      type(run_progress_t), intent(inout) :: progress
+      type(status_t), intent(inout) :: status
+      call file%read_attribute('time', state%time, status)
+      call file%read_attribute('step', state%step, status)
+      call file%read_attribute('dt', state%dt, status)
+      call file%read_attribute('mass_tolerance', state%mass_tolerance, status)
+      call file%read_attribute('next_output_time', state%next_output_time, status)
+      call file%read_attribute('sequence', progress%checkpoints_written, status)
+      call file%read_attribute('ranks', state%ranks_written, status)
+      call file%read_attribute('particles', state%total, status)
+      if (status%ok .and. (state%ranks_written < 1 .or. state%total < 0)) call status%fail(where//' has invalid counts')
+   end subroutine read_counts
+
+   !> Every written rank's particle count and counters (all_ranks: the slab of all of them).
+   subroutine read_rank_tables(file, where, state, all_ranks, status)
+      type(hdf5_file_t), intent(in) :: file
+      character(len=*), intent(in) :: where
+      type(saved_state_t), intent(inout) :: state
+      type(slab_t), intent(out) :: all_ranks
+      type(status_t), intent(inout) :: status
+      associate (ranks => state%ranks_written)
+         allocate (state%rank_counts(ranks), state%lost(ranks), state%corrections(ranks))
+         all_ranks = slab_t(0, ranks, ranks)
+      end associate
+      call file%read_slab('ranks/particles', all_ranks, state%rank_counts, status)
+      call file%read_slab('ranks/lost_particles', all_ranks, state%lost, status)
+      call file%read_slab('ranks/wall_corrections', all_ranks, state%corrections, status)
+      if (status%ok .and. sum(state%rank_counts) /= state%total) call status%fail(where//' has inconsistent particle counts')
+   end subroutine read_rank_tables
+
+   !> The particles this rank reads: on the same number of ranks the slab it wrote, in the writer's
+   !> decomposition (rebalanced or not; ranks keep their numbers in any rank grid), else an even share.
+   subroutine read_particles(file, solver, scene, where, state, status)
+      type(hdf5_file_t), intent(in) :: file
+      type(solver_t), intent(in) :: solver
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: where
+      type(saved_state_t), intent(inout) :: state
+      type(status_t), intent(inout) :: status
+      type(slab_t) :: slab
+      integer :: rank, n_ranks, m
+
+      rank = solver%domain%rank
+      call MPI_Comm_size(solver%domain%comm, n_ranks)
+      state%same_decomposition = state%ranks_written == n_ranks
+      if (state%same_decomposition) then
+         allocate (state%cuts(size(solver%domain%cuts)))
+         call file%read_attribute('cuts', state%cuts, status)
+         if (status%ok) then
+            if (.not. valid_layout(reshape(state%cuts, shape(solver%domain%cuts)), solver%domain%global_cells, &
+                                   solver%domain%dim, n_ranks)) call status%fail(where//' has an invalid decomposition')
+         end if
+         slab = slab_t(sum(state%rank_counts(1:rank)), state%rank_counts(rank + 1), state%total)
+      else
+         slab = even_slab(state%total, rank, n_ranks)
+      end if
+      state%n = int(slab%count)
+      m = max(state%n, 1)
+      allocate (state%x(scene%grid%dim, m), state%v(scene%grid%dim, m), state%mass(m), state%density(m), &
+                state%sbar(solver%particles%n_sigma, m), state%material(m), state%id(m))
+      call file%read_slab('particles/x', slab, state%x, status)
+      call file%read_slab('particles/v', slab, state%v, status)
+      call file%read_slab('particles/mass', slab, state%mass, status)
+      call file%read_slab('particles/density', slab, state%density, status)
+      call file%read_slab('particles/sbar', slab, state%sbar, status)
+      call file%read_slab('particles/material', slab, state%material, status)
+      call file%read_slab('particles/id', slab, state%id, status)
+   end subroutine read_particles
+
+   !> The checkpoint was accepted: its decomposition (same ranks), particles, time, step and counters
+   !> become the solver's. Collective.
+   subroutine adopt_state(state, scene, where, solver, status)
+      type(saved_state_t), intent(in) :: state
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: where
+      type(solver_t), intent(inout) :: solver
+      type(status_t), intent(inout) :: status
+      integer :: rank, p
+
+      rank = solver%domain%rank
+      if (state%same_decomposition) then
+         call solver%set_layout(reshape(state%cuts, shape(solver%domain%cuts)), status)
          if (.not. status%ok) return
       end if
-      call solver%particles%init(scene%grid%dim, size(scene%materials), max(n, 1024))
-      do p = 1, n
-         call solver%particles%add(x(:, p), v(:, p), mass(p), density(p), sbar(:, p), material(p), id(p))
+      call solver%particles%init(scene%grid%dim, size(scene%materials), max(state%n, 1024))
+      do p = 1, state%n
+         call solver%particles%add(state%x(:, p), state%v(:, p), state%mass(p), state%density(p), state%sbar(:, p), &
+                                   state%material(p), state%id(p))
       end do
       call solver%check_particle_memory(status)
       if (.not. status%ok) return
-      solver%time = time
-      solver%step = step
-      solver%dt = dt
-      solver%mass_tolerance = mass_tolerance
-      if (same_decomposition) then
-         solver%lost_particles = int(lost(rank + 1))
-         solver%wall_corrections = int(corrections(rank + 1))
+      solver%time = state%time
+      solver%step = state%step
+      solver%dt = state%dt
+      solver%mass_tolerance = state%mass_tolerance
+      if (state%same_decomposition) then
+         solver%lost_particles = int(state%lost(rank + 1))
+         solver%wall_corrections = int(state%corrections(rank + 1))
          ! keep each rank's order: the continued run is then bitwise identical to an uninterrupted one
-         if (any([(solver%grid%owned_local_cell(x(:, p)) == 0, p = 1, n)])) &
+         if (any([(solver%grid%owned_local_cell(state%x(:, p)) == 0, p = 1, state%n)])) &
             call status%fail(where//': a particle lies outside the cells of the rank that wrote it')
          call agree_on_status(status, solver%domain%comm)
          if (.not. status%ok) return
          call update_cells(solver%grid, solver%particles)
       else
-         solver%lost_particles = merge(int(sum(lost)), 0, rank == 0)
-         solver%wall_corrections = merge(int(sum(corrections)), 0, rank == 0)
+         solver%lost_particles = merge(int(sum(state%lost)), 0, rank == 0)
+         solver%wall_corrections = merge(int(sum(state%corrections)), 0, rank == 0)
          ! the active box around the particles read, each sent to its owner
          call solver%cover_particles(status)
-         if (.not. status%ok) return
       end if
-      progress%next_output_time = next_output_time
-      progress%restarted = .true.
-      progress%restart_step = step
-   end subroutine read_checkpoint
+   end subroutine adopt_state
+
+   !> The scene the checkpoint's run used (stored by write_scene_text) against `scene`: a difference
+   !> outside restart_changeable is refused, or with `allow` reported in `warning`. A checkpoint of
+   !> format version 4 stores no scene: refused, or with `allow` accepted with a warning.
+   subroutine check_scene_changes(file, version, scene, where, allow, warning, status)
+      type(hdf5_file_t), intent(in) :: file
+      integer, intent(in) :: version
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: where
+      logical, intent(in) :: allow
+      character(len=:), allocatable, intent(inout) :: warning
+      type(status_t), intent(inout) :: status
+      type(scene_change_t), allocatable :: changes(:)
+      character(len=:), allocatable :: stored, refused
+
+      if (.not. status%ok) return
+      if (version == unscened_format_version) then
+         if (allow) then
+            warning = where//' stores no scene (format version '//int_text(version)//', an older flotsam): the '// &
+                      'scene was not compared (--allow-scene-change)'
+         else
+            call status%fail(where//' stores no scene (format version '//int_text(version)//', written by an older '// &
+                             'flotsam), so a changed scene cannot be detected; pass --allow-scene-change to continue '// &
+                             'it with this scene')
+         end if
+         return
+      end if
+      call read_scene_text(file, stored, status)
+      if (.not. status%ok) return
+      call compare_scene_texts(stored, where//' (its scene)', scene_namelist_text(scene), 'the scene', changes, status)
+      if (.not. status%ok) return
+      refused = describe_changes(changes, allowed=.false.)
+      if (len(refused) == 0) return
+      if (allow) then
+         warning = 'continuing with a changed scene (--allow-scene-change): '//refused
+      else
+         call status%fail(where//' was written for another scene: '//refused//' (a restart may change only &run '// &
+                          'end_time, max_steps, speed_limit and the output, checkpoint and balancing settings; '// &
+                          '--allow-scene-change continues with the changed scene)')
+      end if
+   end subroutine check_scene_changes
+
+   !> The resolved scene (scene_record) as attributes scene_groups = n and scene_group_1 ... _n, one
+   !> namelist group each (an attribute is limited to 64 KiB; a group stays far below).
+   subroutine write_scene_text(scene, file, status)
+      type(scene_t), intent(in) :: scene
+      type(hdf5_file_t), intent(inout) :: file
+      type(status_t), intent(inout) :: status
+      type(namelist_text_t), allocatable :: groups(:)
+      integer :: g
+      groups = scene_namelist_groups(scene)
+      call file%write_attribute('scene_groups', size(groups), status)
+      do g = 1, size(groups)
+         call file%write_attribute('scene_group_'//int_text(g), groups(g)%text, status)
+      end do
+   end subroutine write_scene_text
+
+   !> The scene text write_scene_text stored, groups on lines of their own.
+   subroutine read_scene_text(file, text, status)
+      type(hdf5_file_t), intent(in) :: file
+      character(len=:), allocatable, intent(out) :: text
+      type(status_t), intent(inout) :: status
+      character(len=group_text_len) :: group
+      integer :: n, g
+      text = ''
+      n = 0
+      call file%read_attribute('scene_groups', n, status)
+      do g = 1, n
+         group = ''
+         call file%read_attribute('scene_group_'//int_text(g), group, status)
+         if (.not. status%ok) return
+         text = text//trim(group)//new_line('a')
+      end do
+   end subroutine read_scene_text
 
    !> What the series of loads.csv, gauges.csv and bodies.csv carry from row to row (load_records): the
    !> last row's time, each rank's wall impulse since then (ranks/load_impulse, one column per rank),

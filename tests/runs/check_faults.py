@@ -7,6 +7,10 @@
     written, exit status 5, and the restarted run reaches the same end state;
   * restart on another number of ranks: equal to 1e-10 relative;
   * a truncated checkpoint and one of another format version are refused with a clear message;
+  * a restart with a changed scene: a changed bulk modulus is refused with status 2 and a message naming
+    material(1)%bulk_modulus, continues with --allow-scene-change (a warning names it); a changed end_time,
+    or only comments, layout, order and number spelling changed, continue silently (the latter bit for
+    bit); a checkpoint of format 4 (no stored scene) is refused, and continued with the flag;
   * an output folder that holds a previous run or cannot be written is refused before the run starts;
     --overwrite replaces the previous run;
   * a blow-up stops the run within the step, names step, time, rank, particle and quantity, and
@@ -44,6 +48,89 @@ def interrupted_run(flotsam, checks, scene, name, wait_for, interrupt):
     restart = flotsam.run(scene, RANKS, "--restart", "latest")
     checks.check(restart.returncode == 0, f"{name}: the restart finished", restart.stderr[-2000:])
     return process, stderr, restart
+
+
+def warning_lines(result):
+    return [line for line in result.stderr.splitlines() if line.startswith("flotsam: warning:")]
+
+
+def continued_copy(flotsam, name, text, *arguments):
+    """Copy the reference run to folder `name`, write `text` (output_dir 'reference') as scene name.nml
+    with output_dir `name`, and continue it there from its third-last checkpoint."""
+    flotsam.remove(name)
+    shutil.copytree(flotsam.path("reference"), flotsam.path(name))
+    scene = flotsam.path(name + ".nml")
+    with open(scene, "w") as f:
+        f.write(text.replace("output_dir = 'reference'", f"output_dir = '{name}'"))
+    checkpoint = sorted(os.listdir(flotsam.path(name, "checkpoints")))[-4]      # [-1] is `latest`
+    return flotsam.run(scene, RANKS, "--restart", os.path.join(name, "checkpoints", checkpoint), *arguments)
+
+
+def check_scene_changes(flotsam, checks, template, reference_text):
+    """A restart compares its scene with the one the checkpoint stores (docs/output.md)."""
+    with open(flotsam.scene(template, "reference.nml", "reference")) as f:
+        scene = f.read()
+
+    def diagnostics(name):
+        with open(flotsam.path(name, "diagnostics.csv")) as f:
+            return f.read()
+
+    stiffer = scene.replace("bulk_modulus = 2.0e6", "bulk_modulus = 1.0e6")
+    checks.check(stiffer != scene, "scene changes: the template sets bulk_modulus = 2.0e6")
+    result = continued_copy(flotsam, "bulk_modulus", stiffer)
+    errors = error_lines(result)
+    checks.check(result.returncode == 2 and len(errors) == 1 and "was written for another scene: "
+                 "material(1)%bulk_modulus: 2000000.0 -> 1000000.0 (" in errors[0] and "--allow-scene-change" in errors[0],
+                 "changed bulk_modulus refused with status 2, the message names it", f"{result.returncode}: {errors}")
+    checks.check(diagnostics("bulk_modulus") == reference_text, "a refused scene leaves the run's files alone")
+
+    result = continued_copy(flotsam, "bulk_modulus", stiffer, "--allow-scene-change")
+    warnings = warning_lines(result)
+    checks.check(result.returncode == 0 and len(warnings) == 1 and "continuing with a changed scene "
+                 "(--allow-scene-change): material(1)%bulk_modulus: 2000000.0 -> 1000000.0" in warnings[0],
+                 "--allow-scene-change continues, with a warning naming the change",
+                 f"{result.returncode}: {warnings} {result.stderr[-1500:]}")
+
+    longer = scene.replace("end_time = 0.15", "end_time = 0.16")
+    result = continued_copy(flotsam, "end_time", longer)
+    rows = read_diagnostics(flotsam.path("end_time"))
+    checks.check(result.returncode == 0 and not warning_lines(result) and abs(float(rows[-1]["time"]) - 0.16) < 1e-12,
+                 "a changed end_time continues silently to the new end",
+                 f"{result.returncode}, last row at t = {rows[-1]['time']}: {result.stderr[-1500:]}")
+
+    # comments, blanks, line breaks, the order of variables and groups, the spelling of numbers and logicals
+    reworded = ("! the same scene, written otherwise\n"
+                + scene.replace("density = 1000.0, bulk_modulus = 2.0e6, viscosity = 1.0e-3",
+                                "viscosity = 0.001,   ! Pa s\n   Density = 1e3,\n   bulk_modulus = 2000000")
+                       .replace("end_time = 0.15", "end_time = 1.5e-1 ! s")
+                       .replace("&gravity acceleration = 0.0, -9.81 /", "")
+                + "\n&gravity\n   acceleration = 0, -9.810  ! m/s^2\n/\n")
+    checks.check("1e3" in reworded and "&gravity\n" in reworded, "scene changes: the reworded scene is reworded")
+    result = continued_copy(flotsam, "reworded", reworded)
+    checks.check(result.returncode == 0 and not warning_lines(result), "the scene written otherwise continues silently",
+                 f"{result.returncode}: {result.stderr[-1500:]}")
+    checks.check(diagnostics("reworded") == reference_text, "reworded: diagnostics bitwise equal to the uninterrupted run")
+
+    # a checkpoint of the previous format, without the scene
+    flotsam.remove("format_4")
+    shutil.copytree(flotsam.path("reference"), flotsam.path("format_4"))
+    checkpoint = sorted(os.listdir(flotsam.path("format_4", "checkpoints")))[-4]
+    with h5py.File(flotsam.path("format_4", "checkpoints", checkpoint), "r+") as f:
+        for k in range(1, int(f.attrs["scene_groups"]) + 1):
+            del f.attrs[f"scene_group_{k}"]
+        del f.attrs["scene_groups"]
+        f.attrs.modify("format_version", 4)
+    old = flotsam.scene(template, "format_4.nml", "format_4")
+    result = flotsam.run(old, RANKS, "--restart", os.path.join("format_4", "checkpoints", checkpoint))
+    errors = error_lines(result)
+    checks.check(result.returncode == 2 and len(errors) == 1 and "stores no scene (format version 4" in errors[0]
+                 and "--allow-scene-change" in errors[0], "a checkpoint without a scene is refused", f"{errors}")
+    result = flotsam.run(old, RANKS, "--restart", os.path.join("format_4", "checkpoints", checkpoint),
+                         "--allow-scene-change")
+    warnings = warning_lines(result)
+    checks.check(result.returncode == 0 and len(warnings) == 1 and "stores no scene" in warnings[0]
+                 and diagnostics("format_4") == reference_text,
+                 "... and continued with --allow-scene-change, with a warning", f"{result.returncode}: {warnings}")
 
 
 def main():
@@ -135,6 +222,8 @@ def main():
                  "checkpoint of another format version refused", f"{result.returncode}: {errors}")
     with open(flotsam.path("reference", "diagnostics.csv")) as f:
         checks.check(f.read() == reference_text, "a refused restart leaves the run's files alone")
+
+    check_scene_changes(flotsam, checks, template, reference_text)
 
     # --- output folders that must be refused ---------------------------------------------------------
     result = flotsam.run(reference_scene, RANKS)

@@ -1,0 +1,411 @@
+!> The resolved scene as namelist text: every variable of every group, with the values the run uses
+!> (after the overrides of the command line and the defaults resolved by resolve_scene). Checkpoints
+!> store it, so that a restart can tell which variables of the scene were changed (scene_comparison).
+!>
+!> Reals are written in the shortest form that reads back exactly (real_text), strings quoted, every
+!> array whole; the text reads back as a scene file giving the same scene.
+module scene_record
+   use kinds, only: rp
+   use scene_description, only: scene_t
+   use scene_reader, only: known_groups, repeated_groups, group_variables
+   use input_text, only: int_text, real_text
+   implicit none
+   private
+
+   public :: scene_namelist_groups, scene_namelist_text
+
+   !> The text of one namelist group, `&name` to `/`, one variable per line.
+   type, public :: namelist_text_t
+      character(len=:), allocatable :: text
+   end type namelist_text_t
+
+   !> The 2 sides of each axis as `&box_walls` names them: x_min is side 1 of axis 1.
+   character(len=*), parameter :: axis_letters = 'xyz'
+
+contains
+
+   !> Every group of the scene in the order of known_groups, a repeated group once per entry.
+   function scene_namelist_groups(scene) result(groups)
+      type(scene_t), intent(in) :: scene
+      type(namelist_text_t), allocatable :: groups(:)
+      integer :: g, k, n
+      n = 0
+      do g = 1, size(known_groups)
+         n = n + entry_count(scene, trim(known_groups(g)))
+      end do
+      allocate (groups(n))
+      n = 0
+      do g = 1, size(known_groups)
+         do k = 1, entry_count(scene, trim(known_groups(g)))
+            n = n + 1
+            groups(n)%text = group_text(scene, trim(known_groups(g)), k)
+         end do
+      end do
+   end function scene_namelist_groups
+
+   !> The whole scene as one namelist text (groups on lines of their own).
+   function scene_namelist_text(scene) result(text)
+      type(scene_t), intent(in) :: scene
+      character(len=:), allocatable :: text
+      type(namelist_text_t), allocatable :: groups(:)
+      integer :: g
+      groups = scene_namelist_groups(scene)
+      text = ''
+      do g = 1, size(groups)
+         text = text//groups(g)%text//new_line('a')
+      end do
+   end function scene_namelist_text
+
+   !> Entries of `group` in the scene: 1 for a singleton group.
+   pure integer function entry_count(scene, group) result(n)
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: group
+      n = 1
+      if (.not. any(repeated_groups == group)) return
+      n = 0
+      select case (group)
+      case ('material')
+         if (allocated(scene%materials)) n = size(scene%materials)
+      case ('body')
+         if (allocated(scene%bodies)) n = size(scene%bodies)
+      case ('wall')
+         if (allocated(scene%walls)) n = size(scene%walls)
+      case ('inlet')
+         if (allocated(scene%inlets)) n = size(scene%inlets)
+      case ('gauge')
+         if (allocated(scene%gauges)) n = size(scene%gauges)
+      end select
+   end function entry_count
+
+   !> Entry k of `group`: every variable the reader knows for it, in its order.
+   function group_text(scene, group, k) result(text)
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: group
+      integer, intent(in) :: k
+      character(len=:), allocatable :: text
+      character(len=:), allocatable :: names(:)
+      integer :: v
+      names = group_variables(group)
+      text = '&'//group
+      do v = 1, size(names)
+         text = text//new_line('a')//'   '//trim(names(v))//' = '//value_text(scene, group, k, trim(names(v)))
+      end do
+      text = text//new_line('a')//'/'
+   end function group_text
+
+   !> The value of variable `name` of entry k of `group` as namelist text; '' for a variable this module
+   !> does not know (the unit test checks that there is none).
+   function value_text(scene, group, k, name) result(text)
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: group, name
+      integer, intent(in) :: k
+      character(len=:), allocatable :: text
+      select case (group)
+      case ('run')
+         text = run_value(scene, name)
+      case ('grid')
+         text = grid_value(scene, name)
+      case ('box_walls')
+         text = box_walls_value(scene, name)
+      case ('gravity')
+         text = ''
+         if (name == 'acceleration') text = reals(scene%gravity)
+      case ('material')
+         text = material_value(scene, k, name)
+      case ('body')
+         text = body_value(scene, k, name)
+      case ('wall')
+         text = wall_value(scene, k, name)
+      case ('inlet')
+         text = inlet_value(scene, k, name)
+      case ('gauge')
+         text = gauge_value(scene, k, name)
+      case default
+         text = ''
+      end select
+   end function value_text
+
+   function run_value(scene, name) result(text)
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: text
+      associate (run => scene%run)
+         select case (name)
+         case ('end_time')
+            text = real_text(run%end_time)
+         case ('cfl')
+            text = real_text(run%cfl)
+         case ('dt')
+            text = real_text(run%fixed_dt)
+         case ('output_interval')
+            text = real_text(run%output_interval)
+         case ('output_dir')
+            text = quoted(run%output_dir)
+         case ('overwrite')
+            text = logical_text(run%overwrite)
+         case ('update_scheme')
+            text = quoted(run%update_scheme)
+         case ('flip_fraction')
+            text = real_text(run%flip_fraction)
+         case ('theta')
+            text = real_text(run%theta)
+         case ('max_steps')
+            text = int_text(run%max_steps)
+         case ('progress_interval')
+            text = real_text(run%progress_interval)
+         case ('floor_size')
+            text = real_text(run%floor_size)
+         case ('particle_output')
+            text = logical_text(run%particle_output)
+         case ('grid_output')
+            text = logical_text(run%grid_output)
+         case ('checkpoint_interval_steps')
+            text = int_text(run%checkpoint_interval_steps)
+         case ('checkpoint_interval_wall')
+            text = real_text(run%checkpoint_interval_wall)
+         case ('checkpoints_kept')
+            text = int_text(run%checkpoints_kept)
+         case ('speed_limit')
+            text = real_text(run%speed_limit)
+         case ('rebalance_threshold')
+            text = real_text(run%rebalance_threshold)
+         case ('rebalance_interval')
+            text = int_text(run%rebalance_interval)
+         case ('load_interval')
+            text = real_text(run%load_interval)
+         case default
+            text = ''
+         end select
+      end associate
+   end function run_value
+
+   function grid_value(scene, name) result(text)
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: text
+      associate (grid => scene%grid)
+         select case (name)
+         case ('dim')
+            text = int_text(grid%dim)
+         case ('cell_size')
+            text = real_text(grid%cell_size)
+         case ('origin')
+            text = reals(grid%origin)
+         case ('extent')
+            text = reals(grid%extent)
+         case ('rotation')
+            text = real_text(grid%rotation)
+         case default
+            text = ''
+         end select
+      end associate
+   end function grid_value
+
+   !> `x_min` ... `z_max`: the side's condition; `x_min_name` ...: its name.
+   function box_walls_value(scene, name) result(text)
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: text
+      integer :: axis, side
+      text = ''
+      if (len(name) < 5) return
+      axis = index(axis_letters, name(1:1))
+      side = 0
+      if (name(2:5) == '_min') side = 1
+      if (name(2:5) == '_max') side = 2
+      if (axis == 0 .or. side == 0) return
+      if (name(6:) == '') then
+         text = quoted(scene%grid%wall(side, axis))
+      else if (name(6:) == '_name') then
+         text = quoted(scene%grid%wall_name(side, axis))
+      end if
+   end function box_walls_value
+
+   function material_value(scene, k, name) result(text)
+      type(scene_t), intent(in) :: scene
+      integer, intent(in) :: k
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: text
+      associate (material => scene%materials(k))
+         select case (name)
+         case ('name')
+            text = quoted(material%name)
+         case ('model')
+            text = quoted(material%model)
+         case ('density')
+            text = real_text(material%density)
+         case ('bulk_modulus')
+            text = real_text(material%bulk_modulus)
+         case ('viscosity')
+            text = real_text(material%viscosity)
+         case ('youngs_modulus')
+            text = real_text(material%youngs_modulus)
+         case ('poisson_ratio')
+            text = real_text(material%poisson_ratio)
+         case ('stabilization')
+            text = quoted(material%stabilization)
+         case ('volumetric_only')
+            text = logical_text(material%volumetric_only)
+         case ('oscillation_rule')
+            text = quoted(material%oscillation_rule)
+         case ('gamma_max')
+            text = real_text(material%gamma_max)
+         case ('smoothed_variables')
+            text = quoted(material%smoothed_variables)
+         case ('cell_averaging')
+            text = logical_text(material%cell_averaging)
+         case ('volume_correction')
+            text = quoted(material%volume_correction)
+         case ('shifting_coefficient')
+            text = real_text(material%shifting_coefficient)
+         case ('eos_relaxation_rate')
+            text = real_text(material%eos_relaxation_rate)
+         case default
+            text = ''
+         end select
+      end associate
+   end function material_value
+
+   function body_value(scene, k, name) result(text)
+      type(scene_t), intent(in) :: scene
+      integer, intent(in) :: k
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: text
+      associate (body => scene%bodies(k))
+         select case (name)
+         case ('name')
+            text = quoted(body%name)
+         case ('material')
+            text = quoted(body%material)
+         case ('lower')
+            text = reals(body%lower)
+         case ('upper')
+            text = reals(body%upper)
+         case ('particles_per_cell')
+            text = int_text(body%particles_per_cell)
+         case ('velocity')
+            text = reals(body%velocity)
+         case ('hydrostatic')
+            text = logical_text(body%hydrostatic)
+         case ('free_surface_level')
+            text = real_text(body%free_surface_level)
+         case default
+            text = ''
+         end select
+      end associate
+   end function body_value
+
+   function wall_value(scene, k, name) result(text)
+      type(scene_t), intent(in) :: scene
+      integer, intent(in) :: k
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: text
+      associate (wall => scene%walls(k))
+         select case (name)
+         case ('point')
+            text = reals(wall%point)
+         case ('normal')
+            text = reals(wall%normal)
+         case ('lower')
+            text = reals(wall%lower)
+         case ('upper')
+            text = reals(wall%upper)
+         case ('condition')
+            text = quoted(wall%condition)
+         case ('name')
+            text = quoted(wall%name)
+         case ('moment_point')
+            text = reals(wall%moment_point)
+         case default
+            text = ''
+         end select
+      end associate
+   end function wall_value
+
+   function inlet_value(scene, k, name) result(text)
+      type(scene_t), intent(in) :: scene
+      integer, intent(in) :: k
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: text
+      associate (inlet => scene%inlets(k))
+         select case (name)
+         case ('name')
+            text = quoted(inlet%name)
+         case ('material')
+            text = quoted(inlet%material)
+         case ('point')
+            text = reals(inlet%point)
+         case ('direction')
+            text = reals(inlet%direction)
+         case ('height')
+            text = real_text(inlet%height)
+         case ('width')
+            text = real_text(inlet%width)
+         case ('velocity')
+            text = real_text(inlet%velocity)
+         case ('start_time')
+            text = real_text(inlet%start_time)
+         case ('end_time')
+            text = real_text(inlet%end_time)
+         case ('particles_per_cell')
+            text = int_text(inlet%particles_per_cell)
+         case ('hydrostatic')
+            text = logical_text(inlet%hydrostatic)
+         case default
+            text = ''
+         end select
+      end associate
+   end function inlet_value
+
+   function gauge_value(scene, k, name) result(text)
+      type(scene_t), intent(in) :: scene
+      integer, intent(in) :: k
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: text
+      associate (gauge => scene%gauges(k))
+         select case (name)
+         case ('name')
+            text = quoted(gauge%name)
+         case ('kind')
+            text = quoted(gauge%kind)
+         case ('point')
+            text = reals(gauge%point)
+         case ('radius')
+            text = real_text(gauge%radius)
+         case default
+            text = ''
+         end select
+      end associate
+   end function gauge_value
+
+   !> 'text' with an apostrophe doubled, trailing blanks removed.
+   pure function quoted(value) result(text)
+      character(len=*), intent(in) :: value
+      character(len=:), allocatable :: text
+      integer :: i
+      text = "'"
+      do i = 1, len_trim(value)
+         text = text//value(i:i)
+         if (value(i:i) == "'") text = text//"'"
+      end do
+      text = text//"'"
+   end function quoted
+
+   pure function logical_text(value) result(text)
+      logical, intent(in) :: value
+      character(len=:), allocatable :: text
+      text = merge('.true. ', '.false.', value)
+      text = trim(text)
+   end function logical_text
+
+   !> "1.0, -9.81, 0.0"
+   function reals(values) result(text)
+      real(rp), intent(in) :: values(:)
+      character(len=:), allocatable :: text
+      integer :: i
+      text = real_text(values(1))
+      do i = 2, size(values)
+         text = text//', '//real_text(values(i))
+      end do
+   end function reals
+end module scene_record
