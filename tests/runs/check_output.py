@@ -116,7 +116,7 @@ def check_run(checks, flotsam, scenes, name, ranks, fluid_materials, empty_rank=
                  f"{name} grid.xmf: one grid per diagnostics time", f"{times}")
     checks.check(all(m.get("CollectionType") == "Spatial" and len(m.findall("Grid[@GridType='Uniform']")) == 1
                      for m in members), f"{name} grid.xmf: each time one uniform grid in a spatial collection")
-    grids = [m.find("Grid") for m in members]
+    grids = [m if m.get("GridType") == "Uniform" else m.find("Grid") for m in members]
     shapes_agree = True
     for g in grids:
         for item in g.iter("DataItem"):

@@ -110,7 +110,8 @@ def check_moving_box(checks, flotsam, scenes, pvbatch, environment):
                         f"{name}: one time step per diagnostics row", f"{particles['times']}, {grid['times']}"):
         return
     # the box of each output as grid.xmf gives it (lower corner, x y z) and the spacing
-    members = ElementTree.parse(os.path.join(directory, "grid.xmf")).getroot().find(".//Grid[@CollectionType='Temporal']")
+    root = ElementTree.parse(os.path.join(directory, "grid.xmf")).getroot()
+    members = root.find(".//Grid[@CollectionType='Temporal']")
     origins, spacing = [], None
     for member in members:
         origin, step = member.iter("Geometry").__next__().findall("DataItem")

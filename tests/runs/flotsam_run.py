@@ -155,9 +155,11 @@ class PrivateDisplay:
 
     def __enter__(self):
         read_end, write_end = os.pipe()
-        # its messages to a file: a pipe nobody reads fills up, and the server then stops answering
+        # -noreset: by default the server resets when its last client leaves, and pvbatch, which opens a
+        # test connection, closes it and connects again at once, then finds no server ("bad X server
+        # connection"). Its messages go to a file: a pipe nobody reads would fill up.
         self.log = tempfile.TemporaryFile()
-        self.process = subprocess.Popen([self.xvfb, "-displayfd", str(write_end), "-nolisten", "tcp",
+        self.process = subprocess.Popen([self.xvfb, "-displayfd", str(write_end), "-nolisten", "tcp", "-noreset",
                                          "-screen", "0", "1280x1024x24"], pass_fds=[write_end],
                                         stdout=subprocess.DEVNULL, stderr=self.log)
         os.close(write_end)
@@ -190,5 +192,6 @@ def main_arguments():
     return sys.argv[1], sys.argv[2], os.path.abspath(sys.argv[3]), sys.argv[4:]
 
 
-__all__ = ["Checks", "Flotsam", "PrivateDisplay", "child_pids", "wait_for_file", "signal_ranks", "read_diagnostics", "signal",
+__all__ = ["Checks", "Flotsam", "PrivateDisplay", "child_pids", "wait_for_file", "signal_ranks", "read_diagnostics",
+           "signal",
            "main_arguments"]
