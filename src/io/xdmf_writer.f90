@@ -1,10 +1,15 @@
 !> XDMF 3 files that describe the HDF5 fields files as time series for ParaView (docs/output.md).
 !>
 !> One file per kind of data, each a single `GridType="Collection" CollectionType="Temporal"` with one
-!> uniform grid per output time (`<Time Value=.../>`):
+!> member per output time (`<Time Value=.../>`):
 !>   particles: `Polyvertex` topology with an explicit connectivity dataset 0..N-1 (without it ParaView
-!>              shows no cells and meshio refuses the file; shared/docs/toolchain.md), XYZ geometry;
-!>   grid:      `3DCoRectMesh` of the active box of cells (one node layer in z in 2-D), ORIGIN_DXDYDZ.
+!>              shows no cells and meshio refuses the file; shared/docs/toolchain.md), XYZ geometry, and
+!>              the positions also as the point array `position` (for meshio's time series reader);
+!>   grid:      `3DCoRectMesh` of the active box of cells (one node layer in z in 2-D), ORIGIN_DXDYDZ,
+!>              each inside a one-grid spatial collection: the box changes from output to output, and
+!>              ParaView's Xdmf3 reader keeps the first step's extent for a series of plain structured
+!>              grids (the render view then shows every step clipped to that box), while the blocks of
+!>              a multiblock data set keep their own extents (docs/output.md).
 !> XDMF lists dimensions slowest first (z y x), which is how a Fortran array a(x, y, z) appears in HDF5.
 !> Only rank 0 calls these writers; the file is written under a temporary name and renamed.
 module xdmf_writer
@@ -46,6 +51,8 @@ contains
       type(output_entry_t), intent(in) :: entries(:)
       type(xdmf_attribute_t), intent(in) :: attributes(:)
       type(status_t), intent(inout) :: status
+      type(xdmf_attribute_t), parameter :: position = xdmf_attribute_t('position', '/particles/position', 'Node', 3, &
+                                                                        .false., 8)
       integer :: unit, e, a
       character(len=:), allocatable :: n, file
       call open_xdmf(path, 'particles', unit, status)
@@ -60,8 +67,11 @@ contains
             '          '//data_item(n, .true., 8, file//':/particles/connectivity'), &
             '        </Topology>', &
             '        <Geometry GeometryType="XYZ">', &
-            '          '//data_item(n//' 3', .false., 8, file//':/particles/position'), &
+            '          '//data_item(n//' 3', .false., position%precision, file//':'//trim(position%dataset)), &
             '        </Geometry>'
+         ! The positions once more as an array: meshio's TimeSeriesReader takes the points of the first
+         ! step only and each step's arrays, and the particle count changes (inflow, particles leaving).
+         call write_attribute(unit, position, n, file)
          do a = 1, size(attributes)
             call write_attribute(unit, attributes(a), n, file)
          end do
@@ -97,14 +107,17 @@ contains
             cell_dims = dims_text(cells)
          end associate
          file = fields_file(entries(e)%index)
-         call begin_step(unit, 'grid', entries(e))
+         ! the time on the member of the temporal collection, where the readers look for it
+         write (unit, '(a)') '      <Grid Name="step" GridType="Collection" CollectionType="Spatial">', &
+            '        <Time Value="'//real_text(entries(e)%time)//'"/>', &
+            '        <Grid Name="grid" GridType="Uniform">'
          if (explicit) then
             write (unit, '(a)') '        <Topology TopologyType="3DSMesh" Dimensions="'//node_dims//'"/>', &
                '        <Geometry GeometryType="XYZ">', &
                '          '//data_item(node_dims//' 3', .false., 8, file//':/grid/node/position'), &
                '        </Geometry>'
          else
-         write (unit, '(a)') '        <Topology TopologyType="3DCoRectMesh" Dimensions="'//node_dims//'"/>', &
+            write (unit, '(a)') '        <Topology TopologyType="3DCoRectMesh" Dimensions="'//node_dims//'"/>', &
             '        <Geometry GeometryType="ORIGIN_DXDYDZ">', &
             '          <DataItem Dimensions="3" NumberType="Float" Precision="8" Format="XML">'// &
             real_text(entries(e)%grid_origin(3))//' '//real_text(entries(e)%grid_origin(2))//' '// &
@@ -120,7 +133,7 @@ contains
                call write_attribute(unit, attributes(a), node_dims, file)
             end if
          end do
-         write (unit, '(a)') '      </Grid>'
+         write (unit, '(a)') '        </Grid>', '      </Grid>'
       end do
       call close_xdmf(path, unit, status)
    end subroutine write_grid_xdmf

@@ -7,8 +7,9 @@ mass sums to the total mass, the largest rank's share (max_rank_share) from the 
 the XDMF files listing every output time. The 2-D scene runs on 3 ranks of which one holds no particle
 (load balancing off); the 3-D scene on 2 ranks, balanced: no rank holds more than 60 % of the
 particles at any output. The run's timing.csv: every phase of the time loop, adding up to the loop's
-wall time, with nothing charged to the smoothing phase of a scene without smoothing. Also runs
-scripts/plot_diagnostics.py.
+wall time, with nothing charged to the smoothing phase of a scene without smoothing. A jet whose
+particle count grows (moving_box_2d): meshio's TimeSeriesReader and scripts/particle_series.py give
+every output its own particles. Also runs scripts/plot_diagnostics.py.
 
 usage: check_output.py <flotsam> <mpiexec> <tests/runs/scenes> <scripts folder>"""
 
@@ -106,11 +107,16 @@ def check_run(checks, flotsam, scenes, name, ranks, fluid_materials, empty_rank=
         checks.check({"velocity", "stress", "mean_stress", "density", "id", "rank"} <= set(point_data),
                      f"{name} particles.xmf: arrays", f"{sorted(point_data)}")
 
-    # the grid time series (a structured mesh, which meshio does not read): times and data items
-    grids = ElementTree.parse(os.path.join(directory, "grid.xmf")).getroot().findall(".//Grid[@GridType='Uniform']")
-    times = [float(g.find("Time").get("Value")) for g in grids]
+    # the grid time series (a structured mesh, which meshio does not read): times and data items. Each
+    # member of the temporal collection is a spatial collection of one uniform grid (docs/output.md).
+    root = ElementTree.parse(os.path.join(directory, "grid.xmf")).getroot()
+    members = list(root.find(".//Grid[@CollectionType='Temporal']"))
+    times = [float(m.find("Time").get("Value")) for m in members]
     checks.check(np.allclose(times, [float(r["time"]) for r in rows], rtol=1e-15, atol=0),
                  f"{name} grid.xmf: one grid per diagnostics time", f"{times}")
+    checks.check(all(m.get("CollectionType") == "Spatial" and len(m.findall("Grid[@GridType='Uniform']")) == 1
+                     for m in members), f"{name} grid.xmf: each time one uniform grid in a spatial collection")
+    grids = [m if m.get("GridType") == "Uniform" else m.find("Grid") for m in members]
     shapes_agree = True
     for g in grids:
         for item in g.iter("DataItem"):
@@ -120,6 +126,57 @@ def check_run(checks, flotsam, scenes, name, ranks, fluid_materials, empty_rank=
             with h5py.File(os.path.join(directory, file)) as f:
                 shapes_agree &= f[dataset].shape == tuple(int(d) for d in item.get("Dimensions").split())
     checks.check(shapes_agree, f"{name} grid.xmf: every data item has the shape of its dataset")
+
+
+def check_particle_series(checks, flotsam, scenes, scripts):
+    """moving_box_2d: the particle count grows with the inflow. meshio's TimeSeriesReader must give every
+    output's own particles (the array `position`, as many rows as every other array), and so must
+    scripts/particle_series.py (a meshio.Mesh per output), equal to the fields files."""
+    name = "moving_box_2d"
+    flotsam.remove(name)
+    scene = flotsam.scene(os.path.join(scenes, name + ".nml"), name + ".nml", name)
+    result = flotsam.run(scene, 2)
+    if not checks.check(result.returncode == 0, f"{name}: run on 2 ranks", result.stderr[-2000:]):
+        return
+    directory = flotsam.path(name)
+    rows = read_diagnostics(directory)
+    counts = [int(r["particles"]) for r in rows]
+    checks.check(len(set(counts)) == len(counts), f"{name}: the particle count changes at every output",
+                 f"{counts}")
+    stored = []
+    for index in range(len(rows)):
+        with h5py.File(os.path.join(directory, "fields", f"fields_{index:06d}.h5")) as f:
+            stored.append((f["particles/position"][:], f["particles/mean_stress"][:]))
+
+    with meshio.xdmf.TimeSeriesReader(os.path.join(directory, "particles.xmf")) as reader:
+        reader.read_points_cells()
+        for k in range(reader.num_steps):
+            time, point_data, _ = reader.read_data(k)
+            position, mean_stress = stored[k]
+            checks.check("position" in point_data and np.array_equal(point_data["position"], position),
+                         f"{name} meshio step {k} (t = {time}): the output's {counts[k]} particle positions",
+                         f"arrays {sorted(point_data)}, {len(point_data.get('position', []))} positions")
+            checks.check(all(len(v) == counts[k] for v in point_data.values()) and
+                         np.array_equal(point_data["mean_stress"], mean_stress),
+                         f"{name} meshio step {k}: every array has {counts[k]} rows",
+                         f"{ {key: len(v) for key, v in point_data.items()} }")
+
+    sys.path.insert(0, scripts)
+    try:
+        from particle_series import particle_steps
+        steps = list(particle_steps(directory))
+    except Exception as error:          # reported as a failed check, not a crash of the test
+        steps = []
+        checks.check(False, f"{name}: scripts/particle_series.py reads the series", repr(error))
+    for k, (time, mesh) in enumerate(steps):
+        position, mean_stress = stored[k]
+        checks.check(time == float(rows[k]["time"]) and np.array_equal(mesh.points, position) and
+                     np.array_equal(mesh.cells[0].data.ravel(), np.arange(counts[k])) and
+                     np.array_equal(mesh.point_data["mean_stress"], mean_stress),
+                     f"{name} particle_series.py step {k}: time, {counts[k]} points, vertex cells, arrays",
+                     f"t = {time}, points {mesh.points.shape}")
+    checks.check(len(steps) == len(rows), f"{name} particle_series.py: one mesh per output",
+                 f"{len(steps)} meshes, {len(rows)} outputs")
 
 
 PHASES = ["particles_to_grid", "grid_update", "walls", "stabilization", "grid_to_particles", "constitutive",
@@ -157,6 +214,8 @@ def main():
     flotsam = Flotsam(flotsam_path, mpiexec, "output")
     check_run(checks, flotsam, scenes, "two_materials_2d", 3, fluid_materials=[1], empty_rank=2)
     check_run(checks, flotsam, scenes, "column_3d", 2, fluid_materials=[1])
+    if rest:
+        check_particle_series(checks, flotsam, scenes, os.path.abspath(rest[0]))
 
     # the matplotlib script plots the diagnostics of a run
     if rest:

@@ -8,6 +8,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 
 MPI_ENVIRONMENT = {
@@ -137,11 +138,60 @@ def read_diagnostics(output_dir):
         return list(csv.DictReader(f))
 
 
+class PrivateDisplay:
+    """A virtual X server of its own for pvbatch (Debian's ParaView renders through X only; it has no
+    EGL or OSMesa build, so `pvbatch --force-offscreen-rendering` still needs a display). Xvfb picks a
+    free display number itself and reports it (-displayfd): no race with other X servers starting at
+    the same moment, which `xvfb-run -a` has (it picks the number from /tmp/.X*-lock files, then
+    starts the server). Use as `with PrivateDisplay() as environment:` and pass `env=environment` to the
+    programs that render; the server is stopped when the block ends (after those programs: pvbatch
+    aborts when its X server goes away under it)."""
+
+    def __init__(self, xvfb="Xvfb", timeout=30):
+        self.xvfb = xvfb
+        self.timeout = timeout
+        self.process = None
+        self.display = None
+
+    def __enter__(self):
+        read_end, write_end = os.pipe()
+        # -noreset: by default the server resets when its last client leaves, and pvbatch, which opens a
+        # test connection, closes it and connects again at once, then finds no server ("bad X server
+        # connection"). Its messages go to a file: a pipe nobody reads would fill up.
+        self.log = tempfile.TemporaryFile()
+        self.process = subprocess.Popen([self.xvfb, "-displayfd", str(write_end), "-nolisten", "tcp", "-noreset",
+                                         "-screen", "0", "1280x1024x24"], pass_fds=[write_end],
+                                        stdout=subprocess.DEVNULL, stderr=self.log)
+        os.close(write_end)
+        number = b""
+        start = time.time()
+        with os.fdopen(read_end, "rb", buffering=0) as pipe:
+            while not number.endswith(b"\n") and time.time() - start < self.timeout:
+                chunk = pipe.read(16)     # Xvfb writes the number once it accepts connections
+                if not chunk:             # it ended without starting
+                    break
+                number += chunk
+        if not number.strip().isdigit():
+            self.__exit__()
+            self.log.seek(0)
+            raise RuntimeError(f"{self.xvfb} did not start: {self.log.read().decode(errors='replace')[-500:]}")
+        self.display = ":" + number.decode().strip()
+        return dict(os.environ, DISPLAY=self.display)
+
+    def __exit__(self, *_):
+        if self.process is not None and self.process.poll() is None:
+            self.process.terminate()
+        if self.process is not None:
+            self.process.wait(timeout=30)
+            self.log.close()
+
+
 def main_arguments():
     if len(sys.argv) < 4:
         sys.exit(f"usage: {sys.argv[0]} <flotsam> <mpiexec> <scene folder> [...]")
     return sys.argv[1], sys.argv[2], os.path.abspath(sys.argv[3]), sys.argv[4:]
 
 
-__all__ = ["Checks", "Flotsam", "child_pids", "wait_for_file", "signal_ranks", "read_diagnostics", "signal",
+__all__ = ["Checks", "Flotsam", "PrivateDisplay", "child_pids", "wait_for_file", "signal_ranks", "read_diagnostics",
+           "signal",
            "main_arguments"]
