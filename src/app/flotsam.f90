@@ -19,6 +19,7 @@ program flotsam
    use status_broadcast, only: broadcast_status
    use input_text, only: int_text
    use simulation, only: run_simulation
+   use provenance, only: write_scene_file
    implicit none
 
    integer, parameter :: exit_scene = 2, exit_output_folder = 3, exit_run = 4, exit_signal = 5
@@ -47,6 +48,8 @@ program flotsam
       if (.not. status%ok) call fail(status, exit_scene)
       call prepare_output_directory(scene%run%output_dir, scene%run%overwrite, MPI_COMM_WORLD, status)
       if (.not. status%ok) call fail(status, exit_output_folder)
+      call write_scene_file(scene, MPI_COMM_WORLD, solver%domain%nranks, status)     ! <output_dir>/scene.nml
+      if (.not. status%ok) call fail(status, exit_output_folder)
    else
       call solver%init(scene, MPI_COMM_WORLD, status, seed_particles=.false.)
       if (.not. status%ok) call fail(status, exit_scene)
@@ -54,6 +57,8 @@ program flotsam
       if (.not. status%ok) call fail(status, exit_output_folder)
       call resolve_restart_path(restart_path, status)
       call read_checkpoint(restart_path, scene, solver, progress, status)
+      if (.not. status%ok) call fail(status, exit_scene)
+      call write_scene_file(scene, MPI_COMM_WORLD, solver%domain%nranks, status, restart_path, solver%step)
       if (.not. status%ok) call fail(status, exit_scene)
       if (rank == 0) write (error_unit, '(a,i0,a,es12.5,a)') 'flotsam: continuing '//restart_path//' from step ', &
          solver%step, ' (t = ', solver%time, ' s)'

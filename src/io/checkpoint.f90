@@ -31,6 +31,7 @@ module checkpoint
    use file_system, only: rename_path, remove_file, path_exists
    use status_broadcast, only: agree_on_status, broadcast_status
    use input_text, only: int_text
+   use provenance, only: write_provenance_attributes, agreed_date
    implicit none
    private
 
@@ -78,6 +79,8 @@ contains
       call file%write_attribute('dt', solver%dt, status)
       call file%write_attribute('mass_tolerance', solver%mass_tolerance, status)
       call file%write_attribute('next_output_time', progress%next_output_time, status)
+      ! program, date and resolved scene (its `ranks` is above)
+      call write_provenance_attributes(file, solver%scene, agreed_date(solver%domain%comm), status)
       call write_particles(solver, file, status)
       call write_series_state(solver, file, status)      ! after write_particles: it made the group ranks
       call write_outputs(solver, progress, file, status)
