@@ -89,6 +89,9 @@ contains
       end if
       diag = solver%diagnostics()
       if (progress%restarted) then
+         ! continued past the end_time it reached (a later end_time): its output there is written, so the
+         ! next one is an interval on, not a step of length 0 to land on it again
+         if (progress%next_output_time <= solver%time) progress%next_output_time = min(solver%time + interval, end_time)
          call write_xdmf(solver, progress, status)
       else
          if (solver%domain%rank == 0) call csv%write_row(diagnostics_row(diag))

@@ -153,7 +153,7 @@ contains
       character(len=*), intent(in) :: header, checkpoint
       integer(i8), intent(in) :: step
       type(status_t), intent(inout) :: status
-      character(len=:), allocatable :: dir, path, text, previous, kept, note
+      character(len=:), allocatable :: dir, path, text, previous, kept, note, variable
       integer :: k, v
 
       dir = trim(scene%run%output_dir)
@@ -165,14 +165,13 @@ contains
          if (.not. status%ok) return
          if (previous == text) return    ! the same scene: the file of the run's start stays
          do v = 1, size(fixed_on_restart)
-            associate (variable => trim(fixed_on_restart(v)))
-               if (line_of(previous, variable) /= line_of(text, variable)) then
-                  call status%fail('--restart: &run '//variable//' differs from the run in '//dir//' ('// &
-                                   line_of(previous, variable)//' in '//path//'); the fields files of one run have '// &
-                                   'one set of datasets: keep it, or start a new run in another output_dir')
-                  return
-               end if
-            end associate
+            variable = trim(fixed_on_restart(v))
+            if (line_of(previous, variable) /= line_of(text, variable)) then
+               call status%fail('--restart: &run '//variable//' differs from the run in '//dir//' ('// &
+                                line_of(previous, variable)//' in '//path//'); the fields files of one run have '// &
+                                'one set of datasets: keep it, or start a new run in another output_dir')
+               return
+            end if
          end do
          k = 1
          do while (path_exists(dir//'/'//previous_scene_nml(k)))
@@ -238,7 +237,6 @@ contains
       character(len=:), allocatable :: text
       integer :: unit, ios, size_bytes
       character(len=256) :: message
-      text = ''
       open (newunit=unit, file=path, access='stream', form='unformatted', status='old', action='read', &
             iostat=ios, iomsg=message)
       if (ios == 0) inquire (unit=unit, size=size_bytes, iostat=ios, iomsg=message)
@@ -247,7 +245,10 @@ contains
          if (size_bytes > 0) read (unit, iostat=ios, iomsg=message) text
          close (unit)
       end if
-      if (ios /= 0) call status%fail('cannot read '//path//': '//trim(message))
+      if (ios /= 0) then
+         call status%fail('cannot read '//path//': '//trim(message))
+         text = ''
+      end if
    end function file_text
 
    !> Write `text` to `path` under a temporary name and rename it when complete.

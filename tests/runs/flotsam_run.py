@@ -134,7 +134,14 @@ def signal_ranks(process, signum):
 def read_diagnostics(output_dir):
     """The rows of diagnostics.csv as dictionaries of strings (exact text, for bitwise comparisons)."""
     with open(os.path.join(output_dir, "diagnostics.csv")) as f:
-        return list(csv.DictReader(f))
+        return list(csv.DictReader(line for line in f if not line.startswith("#")))
+
+
+def csv_data_lines(path):
+    """The header and the rows of a CSV file a run wrote, without its '#' comment lines (which carry
+    the date and the invocation, so they differ between two runs with the same results)."""
+    with open(path) as f:
+        return [line for line in f.read().splitlines() if not line.startswith("#")]
 
 
 def main_arguments():
@@ -143,5 +150,5 @@ def main_arguments():
     return sys.argv[1], sys.argv[2], os.path.abspath(sys.argv[3]), sys.argv[4:]
 
 
-__all__ = ["Checks", "Flotsam", "child_pids", "wait_for_file", "signal_ranks", "read_diagnostics", "signal",
-           "main_arguments"]
+__all__ = ["Checks", "Flotsam", "child_pids", "wait_for_file", "signal_ranks", "read_diagnostics", "csv_data_lines",
+           "signal", "main_arguments"]
