@@ -76,7 +76,7 @@ def diagnostics(folder):
     if not os.path.exists(path):
         return []
     with open(path) as f:
-        return list(csv.DictReader(f))
+        return list(csv.DictReader(line for line in f if not line.startswith("#")))
 
 
 def series(folder, key):
@@ -425,7 +425,7 @@ def run_cost(folder):
     if not os.path.exists(path):
         return float("nan")
     with open(path) as f:
-        return float(list(csv.DictReader(f))[-1]["wall_seconds"])
+        return float(list(csv.DictReader(line for line in f if not line.startswith("#")))[-1]["wall_seconds"])
 
 
 def figure_volume(args):

@@ -102,7 +102,7 @@ def judge(folder, code, stderr, scene):
     if code != 0:
         return f"exit {code}", False, stderr.strip().splitlines()[-1][:200] if stderr.strip() else ""
     with open(os.path.join(folder, "diagnostics.csv")) as f:
-        rows = list(csv.DictReader(f))
+        rows = list(csv.DictReader(line for line in f if not line.startswith("#")))
     energy = max(float(r["kinetic_energy"]) for r in rows)
     bound = RHO * G * H * H * W / 2
     problems = []

@@ -23,6 +23,7 @@ program flotsam
    use input_text, only: int_text, real_text
    use simulation, only: run_simulation
    use build_info, only: flotsam_version, flotsam_git_commit, flotsam_build_type
+   use provenance, only: write_scene_file
    implicit none
 
    integer, parameter :: exit_scene = 2, exit_output_folder = 3, exit_run = 4, exit_signal = 5
@@ -51,6 +52,8 @@ program flotsam
       if (.not. status%ok) call fail(status, exit_scene)
       call prepare_output_directory(scene%run%output_dir, scene%run%overwrite, MPI_COMM_WORLD, status)
       if (.not. status%ok) call fail(status, exit_output_folder)
+      call write_scene_file(scene, MPI_COMM_WORLD, solver%domain%nranks, status)     ! <output_dir>/scene.nml
+      if (.not. status%ok) call fail(status, exit_output_folder)
       call print_banner()
    else
       call solver%init(scene, MPI_COMM_WORLD, status, seed_particles=.false.)
@@ -59,6 +62,8 @@ program flotsam
       if (.not. status%ok) call fail(status, exit_output_folder)
       call resolve_restart_path(restart_path, status)
       call read_checkpoint(restart_path, scene, solver, progress, status, allow_scene_change, scene_warning)
+      if (.not. status%ok) call fail(status, exit_scene)
+      call write_scene_file(scene, MPI_COMM_WORLD, solver%domain%nranks, status, restart_path, solver%step)
       if (.not. status%ok) call fail(status, exit_scene)
       call print_banner()
       if (rank == 0 .and. len(scene_warning) > 0) write (error_unit, '(a)') 'flotsam: warning: '//scene_warning

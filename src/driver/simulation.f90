@@ -15,7 +15,8 @@ module simulation
    use mpi_f08, only: MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER, MPI_MAX
    use error_status, only: status_t
    use mpm_solver, only: solver_t
-   use run_diagnostics, only: diagnostics_t, diagnostics_header, diagnostics_row
+   use run_diagnostics, only: diagnostics_t, diagnostics_header, diagnostics_row, diagnostics_comments
+   use provenance, only: written_by, continued_by, current_date, csv_reading_hint
    use csv_writer, only: csv_writer_t, keep_rows_until
    use load_records, only: load_records_t
    use run_summary, only: write_run_summary, write_timing
@@ -137,6 +138,12 @@ contains
       loop%diag = solver%diagnostics()
       if (progress%restarted) then
          progress%next_output_index = output_index_of(progress%next_output_time, loop%interval, loop%end_time)
+         ! continued past the end_time it reached (a later end_time): its output there is written, so the
+         ! next one is an interval on, not a step of length 0 to land on it again
+         if (progress%next_output_time <= solver%time) then
+            progress%next_output_index = progress%next_output_index + 1
+            progress%next_output_time = scheduled_output_time(progress%next_output_index, loop%interval, loop%end_time)
+         end if
          call write_xdmf(solver, progress, status)
       else
          if (solver%domain%rank == 0) call loop%csv%write_row(diagnostics_row(loop%diag))
@@ -313,8 +320,13 @@ contains
          if (progress%restarted) then
             call keep_rows_until(path, 2, progress%restart_step, status)       ! column 2: step
             if (status%ok) call csv%open(path, diagnostics_header(), status, append=.true.)
+            if (status%ok) call csv%write_row(continued_by(progress%restart_step, solver%time, solver%domain%nranks, &
+                                                           current_date()))
          else
             call csv%open(path, diagnostics_header(), status)
+            call csv%write_row(written_by(solver%domain%nranks, current_date(), solver%scene%source_file)// &
+                               new_line('a')//diagnostics_comments(solver%grid%dim)// &
+                               new_line('a')//csv_reading_hint)
          end if
       end if
       call broadcast_status(status, solver%domain%comm, 0)
@@ -345,7 +357,7 @@ contains
       n = progress%output_count()
       if (solver%domain%rank == 0 .and. n > 0) then
          if (solver%run%particle_output) call write_particles_xdmf(dir//'/'//particles_xdmf, progress%outputs(1:n), &
-                                                                   particle_xdmf_attributes(), status)
+                                                                   particle_xdmf_attributes(solver), status)
          if (solver%run%grid_output) call write_grid_xdmf(dir//'/'//grid_xdmf, progress%outputs(1:n), &
                                                           grid_xdmf_attributes(solver), solver%grid%dim, &
                                                           solver%grid%h, status, solver%grid%frame%rotated)

@@ -5,6 +5,12 @@ module scene_description
    implicit none
    private
 
+   !> The particle datasets `&run particle_fields` may name (position and connectivity are always written).
+   character(len=*), parameter, public :: particle_field_names(*) = [character(len=11) :: 'velocity', 'mass', &
+      'volume', 'density', 'stress', 'mean_stress', 'pressure', 'material', 'id', 'rank']
+   !> `&run field_precision` keywords.
+   character(len=*), parameter, public :: field_precision_keywords(*) = [character(len=6) :: 'double', 'single']
+
    !> Wall condition keywords of the box sides (`&box_walls`).
    character(len=*), parameter, public :: wall_none = 'none'
    character(len=*), parameter, public :: wall_slip = 'slip'      ! [Y17] eq. 14, unilateral, frictionless
@@ -30,6 +36,10 @@ module scene_description
       real(rp) :: floor_size = 0.0_rp         !< tank floor width (2-D) / area (3-D) for h_eq; 0: from grid
       logical :: particle_output = .true.     !< write particle fields (HDF5 + XDMF) at every output time
       logical :: grid_output = .true.         !< write grid fields of the active box at every output time
+      !> precision of the real datasets of the fields files: 'double' or 'single' (positions stay double)
+      character(len=name_len) :: field_precision = 'double'
+      !> particle datasets written: comma-separated names of particle_field_names, or 'all'; position always
+      character(len=path_len) :: particle_fields = 'all'
       integer(i8) :: checkpoint_interval_steps = 0   !< steps between checkpoints; 0: not by steps
       real(rp) :: checkpoint_interval_wall = 3600.0_rp  !< wall seconds between checkpoints; 0: not by time
       integer :: checkpoints_kept = 2         !< newest checkpoints kept on disk
@@ -92,7 +102,7 @@ module scene_description
       logical :: hydrostatic = .false.        !< new particles carry the hydrostatic pressure below the stream top
    end type inlet_spec_t
 
-   public :: opening_tangent, opening_far_end, shifts_particles, relaxes_to_eos
+   public :: opening_tangent, opening_far_end, shifts_particles, relaxes_to_eos, writes_particle_field
 
    !> `&material`: one constitutive model and its parameters.
    type, public :: material_spec_t
@@ -170,6 +180,30 @@ contains
       type(material_spec_t), intent(in) :: material
       relaxes_to_eos = index(material%volume_correction, 'eos_relaxation') > 0
    end function relaxes_to_eos
+
+   !> `&run particle_fields` asks for particle dataset `name` ('all' asks for every one).
+   pure logical function writes_particle_field(run, name)
+      type(run_control_t), intent(in) :: run
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: item
+      integer :: start, comma
+      writes_particle_field = .false.
+      start = 1
+      do
+         comma = index(run%particle_fields(start:), ',')
+         if (comma == 0) then
+            item = trim(adjustl(run%particle_fields(start:)))
+         else
+            item = trim(adjustl(run%particle_fields(start:start + comma - 2)))
+         end if
+         if (item == 'all' .or. item == name) then
+            writes_particle_field = .true.
+            return
+         end if
+         if (comma == 0) return
+         start = start + comma
+      end do
+   end function writes_particle_field
 
    !> The in-plane direction along which an inlet's `height` runs: t = (-d_y, d_x, 0), d the unit
    !> flow direction.

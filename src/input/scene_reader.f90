@@ -71,6 +71,8 @@ module scene_reader
       variable_info_t('run', 'floor_size', 'real', .false.), &
       variable_info_t('run', 'particle_output', 'logical', .false.), &
       variable_info_t('run', 'grid_output', 'logical', .false.), &
+      variable_info_t('run', 'field_precision', 'string', .false.), &
+      variable_info_t('run', 'particle_fields', 'string', .false.), &
       variable_info_t('run', 'checkpoint_interval_steps', 'integer', .false.), &
       variable_info_t('run', 'checkpoint_interval_wall', 'real', .false.), &
       variable_info_t('run', 'checkpoints_kept', 'integer', .false.), &
@@ -772,6 +774,20 @@ contains
       end select
    end subroutine take_text
 
+   !> `text` with every blank removed (a list of names reads the same with or without them).
+   pure function without_blanks(text) result(packed)
+      character(len=*), intent(in) :: text
+      character(len=len(text)) :: packed
+      integer :: i, n
+      packed = ''
+      n = 0
+      do i = 1, len_trim(text)
+         if (text(i:i) == ' ') cycle
+         n = n + 1
+         packed(n:n) = text(i:i)
+      end do
+   end function without_blanks
+
    subroutine read_run_group(control, ios, message, text)
       type(run_control_t), intent(inout) :: control
       integer, intent(out) :: ios
@@ -779,14 +795,14 @@ contains
       character(len=*), intent(in) :: text
       real(rp) :: end_time, cfl, dt, output_interval, flip_fraction, theta, progress_interval, floor_size, &
                   checkpoint_interval_wall, speed_limit, rebalance_threshold, load_interval
-      character(len=text_len) :: output_dir, update_scheme
+      character(len=text_len) :: output_dir, update_scheme, field_precision, particle_fields
       logical :: overwrite, particle_output, grid_output
       integer(i8) :: max_steps, checkpoint_interval_steps
       integer :: checkpoints_kept, rebalance_interval
       namelist /run/ end_time, cfl, dt, output_interval, output_dir, overwrite, update_scheme, flip_fraction, &
          theta, max_steps, progress_interval, floor_size, particle_output, grid_output, checkpoint_interval_steps, &
          checkpoint_interval_wall, checkpoints_kept, speed_limit, rebalance_threshold, rebalance_interval, &
-         load_interval
+         load_interval, field_precision, particle_fields
 
       end_time = control%end_time
       cfl = control%cfl
@@ -802,6 +818,8 @@ contains
       floor_size = control%floor_size
       particle_output = control%particle_output
       grid_output = control%grid_output
+      field_precision = control%field_precision
+      particle_fields = control%particle_fields
       checkpoint_interval_steps = control%checkpoint_interval_steps
       checkpoint_interval_wall = control%checkpoint_interval_wall
       checkpoints_kept = control%checkpoints_kept
@@ -812,6 +830,8 @@ contains
       read (text, nml=run, iostat=ios, iomsg=message)
       call take_text('output_dir', output_dir, control%output_dir, ios, message)
       call take_text('update_scheme', update_scheme, control%update_scheme, ios, message, fold='upper')
+      call take_text('field_precision', field_precision, control%field_precision, ios, message, fold='lower')
+      call take_text('particle_fields', particle_fields, control%particle_fields, ios, message)
       if (ios /= 0) return
       control%end_time = end_time
       control%cfl = cfl
@@ -825,6 +845,7 @@ contains
       control%floor_size = floor_size
       control%particle_output = particle_output
       control%grid_output = grid_output
+      control%particle_fields = without_blanks(lower_case(control%particle_fields))
       control%checkpoint_interval_steps = checkpoint_interval_steps
       control%checkpoint_interval_wall = checkpoint_interval_wall
       control%checkpoints_kept = checkpoints_kept

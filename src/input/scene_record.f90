@@ -3,7 +3,10 @@
 !> store it, so that a restart can tell which variables of the scene were changed (scene_comparison).
 !>
 !> Reals are written in the shortest form that reads back exactly (real_text), strings quoted, every
-!> array whole; the text reads back as a scene file giving the same scene.
+!> array whole; the text reads back as a scene file giving the same scene. The same text is the
+!> output folder's scene.nml and the `scene` attribute of every HDF5 file (provenance).
+!> `&run overwrite` is left out: it is an action on the output folder, not part of the scene, and a run
+!> started again from the text must not replace results silently.
 module scene_record
    use kinds, only: rp
    use scene_description, only: scene_t
@@ -88,6 +91,7 @@ contains
       names = group_variables(group)
       text = '&'//group
       do v = 1, size(names)
+         if (group == 'run' .and. names(v) == 'overwrite') cycle
          text = text//new_line('a')//'   '//trim(names(v))//' = '//value_text(scene, group, k, trim(names(v)))
       end do
       text = text//new_line('a')//'/'
@@ -141,8 +145,6 @@ contains
             text = real_text(run%output_interval)
          case ('output_dir')
             text = quoted(run%output_dir)
-         case ('overwrite')
-            text = logical_text(run%overwrite)
          case ('update_scheme')
             text = quoted(run%update_scheme)
          case ('flip_fraction')
@@ -159,6 +161,10 @@ contains
             text = logical_text(run%particle_output)
          case ('grid_output')
             text = logical_text(run%grid_output)
+         case ('field_precision')
+            text = quoted(run%field_precision)
+         case ('particle_fields')
+            text = quoted(run%particle_fields)
          case ('checkpoint_interval_steps')
             text = int_text(run%checkpoint_interval_steps)
          case ('checkpoint_interval_wall')

@@ -8,7 +8,8 @@ module scene_validation
    use error_status, only: status_t
    use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
                                 inlet_spec_t, gauge_spec_t, opening_far_end, wall_none, wall_slip, wall_no_slip, &
-                                model_newtonian_fluid, model_linear_elastic, gauge_pressure, gauge_level, gauge_velocity
+                                model_newtonian_fluid, model_linear_elastic, gauge_pressure, gauge_level, gauge_velocity, &
+                                particle_field_names, field_precision_keywords
    use input_text, only: int_text, real_text, quoted_list, group_context, ordinal
    use memory_budget, only: memory_budget_t, byte_text
    implicit none
@@ -431,7 +432,42 @@ contains
          call status%fail(where//': variable rebalance_interval must be >= 1, got '//int_text(run%rebalance_interval))
       end if
       call check_real(where, 'load_interval', run%load_interval, status, at_least=0.0_rp)
+      if (status%ok .and. all(run%field_precision /= field_precision_keywords)) then
+         call status%fail(where//': variable field_precision must be one of '//quoted_list(field_precision_keywords)// &
+                          ", got '"//trim(run%field_precision)//"'")
+      end if
+      if (status%ok) call check_particle_fields(where, run%particle_fields, status)
    end subroutine validate_run
+
+   !> `&run particle_fields` is a comma-separated list of particle datasets (or 'all'; 'position' is
+   !> always written and may be named).
+   subroutine check_particle_fields(where, fields, status)
+      character(len=*), intent(in) :: where, fields
+      type(status_t), intent(inout) :: status
+      character(len=:), allocatable :: item
+      integer :: start, comma
+      start = 1
+      do
+         comma = index(fields(start:), ',')
+         if (comma == 0) then
+            item = trim(fields(start:))
+         else
+            item = fields(start:start + comma - 2)
+         end if
+         if (item /= 'all' .and. item /= 'position' .and. all(particle_field_names /= item)) then
+            if (len(item) == 0) then
+               call status%fail(where//": variable particle_fields has an empty name in '"//trim(fields)// &
+                                "' (a comma-separated list of "//quoted_list(particle_field_names)//", or 'all')")
+            else
+               call status%fail(where//": variable particle_fields: unknown field '"//item//"' (fields: "// &
+                                quoted_list(particle_field_names)//", or 'all'; position is always written)")
+            end if
+            return
+         end if
+         if (comma == 0) return
+         start = start + comma
+      end do
+   end subroutine check_particle_fields
 
    subroutine validate_grid(grid, path, status)
       type(grid_spec_t), intent(in) :: grid

@@ -37,6 +37,7 @@ module checkpoint
    use input_text, only: int_text
    use scene_record, only: namelist_text_t, scene_namelist_groups, scene_namelist_text
    use scene_comparison, only: scene_change_t, compare_scene_texts, describe_changes
+   use provenance, only: write_provenance_attributes, agreed_date
    implicit none
    private
 
@@ -105,6 +106,8 @@ contains
       call file%write_attribute('mass_tolerance', solver%mass_tolerance, status)
       call file%write_attribute('next_output_time', progress%next_output_time, status)
       call write_scene_text(solver%scene, file, status)
+      ! program, date and resolved scene (its `ranks` is above)
+      call write_provenance_attributes(file, solver%scene, agreed_date(solver%domain%comm), status)
       call write_particles(solver, file, status)
       call write_series_state(solver, file, status)      ! after write_particles: it made the group ranks
       call write_outputs(solver, progress, file, status)

@@ -13,7 +13,7 @@
 !> corner; the nodes on the upper faces of the box belong to the ranks owning the last cells.
 module field_output
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
-   use kinds, only: rp, i8
+   use kinds, only: rp, i8, name_len
    use error_status, only: status_t
    use mpi_f08, only: MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER, MPI_LOGICAL, MPI_MIN, MPI_MAX, MPI_LAND
    use tensor_layout, only: mean_stress
@@ -21,7 +21,9 @@ module field_output
    use grid_transfer, only: particles_to_grid
    use node_halo, only: sum_shared_nodes
    use mpm_solver, only: solver_t
-   use hdf5_file, only: hdf5_file_t, slab_t, distributed_slab
+   use hdf5_file, only: hdf5_file_t, slab_t, distributed_slab, to_single
+   use scene_description, only: writes_particle_field
+   use provenance, only: write_provenance_attributes, agreed_date
    use xdmf_writer, only: xdmf_attribute_t, output_entry_t
    use output_layout, only: fields_file, temporary_suffix
    use file_system, only: rename_path
@@ -53,6 +55,8 @@ contains
       call file%write_attribute('step', solver%step, status)
       call file%write_attribute('output_index', index, status)
       call file%write_attribute('dim', solver%grid%dim, status)
+      call write_provenance_attributes(file, solver%scene, agreed_date(solver%domain%comm), status, &
+                                       solver%domain%nranks)
       if (solver%run%particle_output) call write_particle_fields(solver, file, entry, status)
       ! the state of a blow-up written for inspection may have particles nowhere: then no grid
       if (solver%run%grid_output) then
@@ -67,7 +71,9 @@ contains
       call broadcast_status(status, solver%domain%comm, 0)
    end subroutine write_fields
 
-   !> /particles: every particle's state in the world frame and a Polyvertex connectivity 0..N-1.
+   !> /particles: every particle's state in the world frame and a Polyvertex connectivity 0..N-1; the
+   !> datasets `&run particle_fields` chooses (position and connectivity always), each with its units and
+   !> description, reals in `&run field_precision` (positions always double: the geometry).
    subroutine write_particle_fields(solver, file, entry, status)
       type(solver_t), intent(in) :: solver
       type(hdf5_file_t), intent(inout) :: file
@@ -77,47 +83,152 @@ contains
       real(rp), allocatable :: vectors(:, :), tensors(:, :), scalars(:), sigma(:, :)
       integer, allocatable :: integers(:)
       integer(i8), allocatable :: ids(:)
-      integer :: n, p
+      integer :: n, p, m
+      logical :: single
+      character(len=:), allocatable :: per_depth
+      character(len=name_len), allocatable :: names(:)
 
       n = solver%particles%count
+      single = solver%run%field_precision == 'single'
       slab = distributed_slab(solver%domain%comm, n)
       entry%particles = slab%total
+      per_depth = ''
+      if (solver%grid%dim == 2) per_depth = ' per metre of thickness (2-D plane strain)'
       call file%create_group('particles', status)
-      associate (particles => solver%particles)
+      associate (particles => solver%particles, run => solver%run)
          allocate (vectors(3, max(n, 1)), tensors(9, max(n, 1)), scalars(max(n, 1)), integers(max(n, 1)), &
                    ids(max(n, 1)))
          call solver%grid%frame%to_world_points(particles%x(:, 1:n), vectors)
          call file%write_slab('particles/position', slab, vectors, status)
-         call solver%grid%frame%to_world_vectors(particles%v(:, 1:n), vectors)
-         call file%write_slab('particles/velocity', slab, vectors, status)
-         scalars(1:n) = particles%mass(1:n)
-         call file%write_slab('particles/mass', slab, scalars, status)
-         scalars(1:n) = particles%density(1:n)
-         call file%write_slab('particles/density', slab, scalars, status)
-         scalars(1:n) = particles%mass(1:n) / particles%density(1:n)
-         call file%write_slab('particles/volume', slab, scalars, status)
+         call describe(file, 'particles/position', 'm', 'position in the world frame (x, y, z; z = 0 in 2-D)', status)
+         if (writes_particle_field(run, 'velocity')) then
+            call solver%grid%frame%to_world_vectors(particles%v(:, 1:n), vectors)
+            call put_reals(file, 'particles/velocity', slab, vectors, single, 'm/s', &
+                           'velocity in the world frame (x, y, z; z = 0 in 2-D)', status)
+         end if
+         if (writes_particle_field(run, 'mass')) then
+            scalars(1:n) = particles%mass(1:n)
+            call put_real(file, 'particles/mass', slab, scalars, single, merge('kg/m', 'kg  ', solver%grid%dim == 2), &
+                          'mass (constant)'//per_depth, status)
+         end if
+         if (writes_particle_field(run, 'density')) then
+            scalars(1:n) = particles%density(1:n)
+            call put_real(file, 'particles/density', slab, scalars, single, 'kg/m^3', 'current density rho', status)
+         end if
+         if (writes_particle_field(run, 'volume')) then
+            scalars(1:n) = particles%mass(1:n) / particles%density(1:n)
+            call put_real(file, 'particles/volume', slab, scalars, single, merge('m^2', 'm^3', solver%grid%dim == 2), &
+                          'current volume m / rho'//per_depth, status)
+         end if
          do p = 1, n
             scalars(p) = particles%density(p) * mean_stress(particles%sbar(:, p))
          end do
-         call file%write_slab('particles/mean_stress', slab, scalars, status)
-         allocate (sigma(particles%n_sigma, max(n, 1)))
-         do p = 1, n
-            sigma(:, p) = particles%density(p) * particles%sbar(:, p)
-         end do
-         call solver%grid%frame%to_world_tensors(sigma(:, 1:n), particles%dim, tensors)
-         call file%write_slab('particles/stress', slab, tensors, status)
-         integers(1:n) = particles%material(1:n)
-         call file%write_slab('particles/material', slab, integers, status)
-         integers(1:n) = solver%domain%rank
-         call file%write_slab('particles/rank', slab, integers, status)
-         ids(1:n) = particles%id(1:n)
-         call file%write_slab('particles/id', slab, ids, status)
+         if (writes_particle_field(run, 'mean_stress')) &
+            call put_real(file, 'particles/mean_stress', slab, scalars, single, 'Pa', &
+                          'mean stress (sxx + syy + szz) / 3 = -pressure (negative in compression)', status)
+         if (writes_particle_field(run, 'pressure')) then
+            scalars(1:n) = -scalars(1:n)
+            call put_real(file, 'particles/pressure', slab, scalars, single, 'Pa', &
+                          'pressure p = -(sxx + syy + szz) / 3 = -mean_stress (positive in compression; the fluid '// &
+                          'pressure of docs/theory.md)', status)
+         end if
+         if (writes_particle_field(run, 'stress')) then
+            allocate (sigma(particles%n_sigma, max(n, 1)))
+            do p = 1, n
+               sigma(:, p) = particles%density(p) * particles%sbar(:, p)
+            end do
+            call solver%grid%frame%to_world_tensors(sigma(:, 1:n), particles%dim, tensors)
+            call put_reals(file, 'particles/stress', slab, tensors, single, 'Pa', 'Cauchy stress in the world frame, '// &
+                           'row by row: xx, xy, xz, yx, yy, yz, zx, zy, zz (tension positive; 2-D: szz of plane strain)', &
+                           status)
+         end if
+         if (writes_particle_field(run, 'material')) then
+            integers(1:n) = particles%material(1:n)
+            call file%write_slab('particles/material', slab, integers, status)
+            allocate (names(size(solver%materials)))
+            do m = 1, size(solver%materials)
+               names(m) = solver%materials(m)%model%name
+            end do
+            call describe(file, 'particles/material', '-', 'material number k = 1, 2, ...: the k-th &material '// &
+                          'group, named material_names[k-1]', status)
+            call file%write_object_attribute('particles/material', 'material_names', names, status)
+         end if
+         if (writes_particle_field(run, 'rank')) then
+            integers(1:n) = solver%domain%rank
+            call file%write_slab('particles/rank', slab, integers, status)
+            call describe(file, 'particles/rank', '-', 'rank that owned the particle', status)
+         end if
+         if (writes_particle_field(run, 'id')) then
+            ids(1:n) = particles%id(1:n)
+            call file%write_slab('particles/id', slab, ids, status)
+            call describe(file, 'particles/id', '-', 'globally unique particle id, the same in every output '// &
+                          'and for any number of ranks', status)
+         end if
          do p = 1, n
             ids(p) = slab%offset + p - 1
          end do
          call file%write_slab('particles/connectivity', slab, ids, status)
+         call describe(file, 'particles/connectivity', '-', '0 .. N-1: one vertex cell per particle (XDMF '// &
+                       'Polyvertex topology)', status)
       end associate
    end subroutine write_particle_fields
+
+   !> The attributes `units` and `description` of dataset `name`.
+   subroutine describe(file, name, units, description, status)
+      type(hdf5_file_t), intent(inout) :: file
+      character(len=*), intent(in) :: name, units, description
+      type(status_t), intent(inout) :: status
+      call file%write_object_attribute(name, 'units', trim(units), status)
+      call file%write_object_attribute(name, 'description', description, status)
+   end subroutine describe
+
+   !> A 1-D particle dataset in double or single precision, described.
+   subroutine put_real(file, name, slab, values, single, units, description, status)
+      type(hdf5_file_t), intent(inout) :: file
+      character(len=*), intent(in) :: name, units, description
+      type(slab_t), intent(in) :: slab
+      real(rp), intent(in), contiguous :: values(:)
+      logical, intent(in) :: single
+      type(status_t), intent(inout) :: status
+      if (single) then
+         call file%write_slab(name, slab, to_single(values), status)
+      else
+         call file%write_slab(name, slab, values, status)
+      end if
+      call describe(file, name, units, description, status)
+   end subroutine put_real
+
+   !> A particle dataset of vectors or tensors (one column per particle) in double or single precision.
+   subroutine put_reals(file, name, slab, values, single, units, description, status)
+      type(hdf5_file_t), intent(inout) :: file
+      character(len=*), intent(in) :: name, units, description
+      type(slab_t), intent(in) :: slab
+      real(rp), intent(in), contiguous :: values(:, :)
+      logical, intent(in) :: single
+      type(status_t), intent(inout) :: status
+      if (single) then
+         call file%write_slab(name, slab, reshape(to_single(reshape(values, [size(values)])), shape(values)), status)
+      else
+         call file%write_slab(name, slab, values, status)
+      end if
+      call describe(file, name, units, description, status)
+   end subroutine put_reals
+
+   !> A grid dataset (a block of the active box) in double or single precision, described.
+   subroutine put_block(file, name, global, offset, local, values, single, units, description, status)
+      type(hdf5_file_t), intent(inout) :: file
+      character(len=*), intent(in) :: name, units, description
+      integer(i8), intent(in) :: global(:), offset(:), local(:)
+      real(rp), intent(in), contiguous :: values(:)
+      logical, intent(in) :: single
+      type(status_t), intent(inout) :: status
+      if (single) then
+         call file%write_block(name, global, offset, local, to_single(values), status)
+      else
+         call file%write_block(name, global, offset, local, values, status)
+      end if
+      call describe(file, name, units, description, status)
+   end subroutine put_block
 
    !> /grid: nodal mass and velocity, and per material the cell averages of density and mean stress
    !> (volume weighted: sum m / sum V, and sum V sigma_m / sum V) on the active box.
@@ -131,7 +242,8 @@ contains
       real(rp), allocatable :: node_mass(:), node_velocity(:, :), density(:), stress(:), corner(:, :), &
                                node_position(:, :)
       real(rp) :: world_corner(3, 1)
-      character(len=:), allocatable :: name
+      character(len=:), allocatable :: name, per_depth
+      logical :: single
 
       dim = solver%grid%dim
       allocate (corner(dim, 1))
@@ -169,22 +281,34 @@ contains
       call sum_shared_nodes(solver%domain, solver%grid, solver%grid%accumulated)
       call nodal_fields(solver, cell_lo, node_hi, local_nodes, node_mass, node_velocity, node_position)
 
+      single = solver%run%field_precision == 'single'
+      name = ''
+      per_depth = ''
+      if (dim == 2) per_depth = ' per metre of thickness (2-D plane strain)'
       call file%create_group('grid', status)
       call file%create_group('grid/node', status)
       call file%create_group('grid/cell', status)
-      call file%write_block('grid/node/mass', nodes, offset, local_nodes, node_mass, status)
-      call file%write_block('grid/node/velocity', [3_i8, nodes], [0_i8, offset], [3_i8, local_nodes], &
-                            reshape(node_velocity, [size(node_velocity)]), status)
-      ! a rotated grid is not a rectilinear mesh in the world: its node positions go into the file
+      call put_block(file, 'grid/node/mass', nodes, offset, local_nodes, node_mass, single, &
+                     merge('kg/m', 'kg  ', dim == 2), 'nodal mass sum N_ip m_p'//per_depth, status)
+      call put_block(file, 'grid/node/velocity', [3_i8, nodes], [0_i8, offset], [3_i8, local_nodes], &
+                     reshape(node_velocity, [size(node_velocity)]), single, 'm/s', &
+                     'nodal velocity (sum N_ip m_p v_p) / m_i in the world frame; 0 on empty nodes', status)
+      ! a rotated grid is not a rectilinear mesh in the world: its node positions go into the file (always
+      ! double: the geometry)
       if (solver%grid%frame%rotated) then
          call file%write_block('grid/node/position', [3_i8, nodes], [0_i8, offset], [3_i8, local_nodes], &
                                reshape(node_position, [size(node_position)]), status)
+         call describe(file, 'grid/node/position', 'm', 'world position of each node (the grid is rotated)', status)
       end if
       do m = 1, size(solver%materials)
          call cell_averages(solver, m, cell_lo, local_cells, density, stress)
          name = material_field_name(solver, m)
-         call file%write_block('grid/cell/density_'//name, cells, offset, local_cells, density, status)
-         call file%write_block('grid/cell/mean_stress_'//name, cells, offset, local_cells, stress, status)
+         call put_block(file, 'grid/cell/density_'//name, cells, offset, local_cells, density, single, 'kg/m^3', &
+                        "cell average of the density of material '"//trim(solver%materials(m)%model%name)// &
+                        "', sum m_p / sum V_p; NaN where the cell holds none of it", status)
+         call put_block(file, 'grid/cell/mean_stress_'//name, cells, offset, local_cells, stress, single, 'Pa', &
+                        "volume-weighted cell average of the mean stress (-pressure) of material '"// &
+                        trim(solver%materials(m)%model%name)//"', sum V_p s_m,p / sum V_p; NaN where absent", status)
       end do
    end subroutine write_grid_fields
 
@@ -345,32 +469,44 @@ contains
       if (len(name) == 0) name = 'material'
    end function safe_name
 
-   !> The XDMF description of /particles.
-   function particle_xdmf_attributes() result(attributes)
+   !> The XDMF description of /particles: the datasets `&run particle_fields` chose, reals in the
+   !> precision of `&run field_precision` (4 or 8 bytes, as written).
+   function particle_xdmf_attributes(solver) result(attributes)
+      type(solver_t), intent(in) :: solver
       type(xdmf_attribute_t), allocatable :: attributes(:)
-      attributes = [xdmf_attribute_t('velocity', '/particles/velocity', 'Node', 3, .false., 8), &
-                    xdmf_attribute_t('mass', '/particles/mass', 'Node', 1, .false., 8), &
-                    xdmf_attribute_t('volume', '/particles/volume', 'Node', 1, .false., 8), &
-                    xdmf_attribute_t('density', '/particles/density', 'Node', 1, .false., 8), &
-                    xdmf_attribute_t('stress', '/particles/stress', 'Node', 9, .false., 8), &
-                    xdmf_attribute_t('mean_stress', '/particles/mean_stress', 'Node', 1, .false., 8), &
-                    xdmf_attribute_t('material', '/particles/material', 'Node', 1, .true., 4), &
-                    xdmf_attribute_t('id', '/particles/id', 'Node', 1, .true., 8), &
-                    xdmf_attribute_t('rank', '/particles/rank', 'Node', 1, .true., 4)]
+      type(xdmf_attribute_t) :: every(10)
+      integer :: bytes, k
+      bytes = merge(4, 8, solver%run%field_precision == 'single')
+      every = [xdmf_attribute_t('velocity', '/particles/velocity', 'Node', 3, .false., bytes), &
+             xdmf_attribute_t('mass', '/particles/mass', 'Node', 1, .false., bytes), &
+             xdmf_attribute_t('volume', '/particles/volume', 'Node', 1, .false., bytes), &
+             xdmf_attribute_t('density', '/particles/density', 'Node', 1, .false., bytes), &
+             xdmf_attribute_t('stress', '/particles/stress', 'Node', 9, .false., bytes), &
+             xdmf_attribute_t('mean_stress', '/particles/mean_stress', 'Node', 1, .false., bytes), &
+             xdmf_attribute_t('pressure', '/particles/pressure', 'Node', 1, .false., bytes), &
+             xdmf_attribute_t('material', '/particles/material', 'Node', 1, .true., 4), &
+             xdmf_attribute_t('id', '/particles/id', 'Node', 1, .true., 8), &
+             xdmf_attribute_t('rank', '/particles/rank', 'Node', 1, .true., 4)]
+      allocate (attributes(0))
+      do k = 1, size(every)
+         if (writes_particle_field(solver%run, trim(every(k)%name))) attributes = [attributes, every(k)]
+      end do
    end function particle_xdmf_attributes
 
-   !> The XDMF description of /grid for the solver's materials.
+   !> The XDMF description of /grid for the solver's materials, reals in the precision written.
    function grid_xdmf_attributes(solver) result(attributes)
       type(solver_t), intent(in) :: solver
       type(xdmf_attribute_t), allocatable :: attributes(:)
       character(len=:), allocatable :: name
-      integer :: m
-      attributes = [xdmf_attribute_t('mass', '/grid/node/mass', 'Node', 1, .false., 8), &
-                    xdmf_attribute_t('velocity', '/grid/node/velocity', 'Node', 3, .false., 8)]
+      integer :: m, bytes
+      bytes = merge(4, 8, solver%run%field_precision == 'single')
+      attributes = [xdmf_attribute_t('mass', '/grid/node/mass', 'Node', 1, .false., bytes), &
+                    xdmf_attribute_t('velocity', '/grid/node/velocity', 'Node', 3, .false., bytes)]
       do m = 1, size(solver%materials)
          name = material_field_name(solver, m)
-         attributes = [attributes, xdmf_attribute_t('density_'//name, '/grid/cell/density_'//name, 'Cell', 1, .false., 8), &
-                       xdmf_attribute_t('mean_stress_'//name, '/grid/cell/mean_stress_'//name, 'Cell', 1, .false., 8)]
+         attributes = [attributes, xdmf_attribute_t('density_'//name, '/grid/cell/density_'//name, 'Cell', 1, .false., &
+                                                    bytes), &
+                       xdmf_attribute_t('mean_stress_'//name, '/grid/cell/mean_stress_'//name, 'Cell', 1, .false., bytes)]
       end do
    end function grid_xdmf_attributes
 end module field_output

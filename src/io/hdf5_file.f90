@@ -11,7 +11,7 @@
 !> and object named; HDF5's own error stack printing is switched off.
 module hdf5_file
    use, intrinsic :: iso_c_binding, only: c_loc, c_ptr, c_char
-   use, intrinsic :: iso_fortran_env, only: int32, int64, real64
+   use, intrinsic :: iso_fortran_env, only: int32, int64, real32, real64
    use, intrinsic :: ieee_exceptions, only: ieee_flag_type, ieee_invalid, ieee_divide_by_zero, ieee_overflow, &
                                             ieee_get_halting_mode, ieee_set_halting_mode, ieee_set_flag
    use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5eset_auto_f, h5pcreate_f, h5pclose_f, h5pset_fapl_mpio_f, &
@@ -20,6 +20,7 @@ module hdf5_file
                    h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, h5dcreate_f, h5dopen_f, h5dclose_f, &
                    h5dwrite_f, h5dread_f, h5dget_space_f, h5acreate_f, h5aopen_f, h5aclose_f, h5awrite_f, h5aread_f, &
                    h5aexists_f, h5aget_type_f, h5aget_space_f, h5tget_size_f, h5tcopy_f, h5tset_size_f, h5tclose_f, h5lexists_f, &
+                   h5oopen_f, h5oclose_f, &
                    h5kind_to_type, H5_REAL_KIND, H5_INTEGER_KIND, H5P_FILE_ACCESS_F, H5P_DATASET_XFER_F, &
                    H5FD_MPIO_COLLECTIVE_F, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, H5F_SCOPE_GLOBAL_F, H5S_SCALAR_F, &
                    H5S_SELECT_SET_F, H5T_FORTRAN_S1
@@ -49,15 +50,20 @@ module hdf5_file
       procedure :: has => file_has
       procedure :: dataset_dims => file_dataset_dims
       procedure :: has_attribute => file_has_attribute
-      generic :: write_slab => write_slab_real1, write_slab_real2, write_slab_int1, write_slab_i81
+      generic :: write_slab => write_slab_real1, write_slab_real2, write_slab_int1, write_slab_i81, write_slab_single1, &
+         write_slab_single2
       generic :: read_slab => read_slab_real1, read_slab_real2, read_slab_int1, read_slab_i81
-      procedure :: write_block => file_write_block
+      generic :: write_block => file_write_block, file_write_block_single
       procedure :: read_block => file_read_block
       generic :: write_attribute => attribute_write_real, attribute_write_int, attribute_write_i8, &
          attribute_write_string, attribute_write_real_array, attribute_write_int_array, attribute_write_i8_array
       generic :: read_attribute => attribute_read_real, attribute_read_int, attribute_read_i8, attribute_read_string, &
          attribute_read_real_array, attribute_read_int_array
-      procedure, private :: write_slab_real1, write_slab_real2, write_slab_int1, write_slab_i81
+      !> string attributes of a dataset or group (units, description, material names)
+      generic :: write_object_attribute => object_attribute_write_string, object_attribute_write_strings
+      procedure, private :: write_slab_real1, write_slab_real2, write_slab_int1, write_slab_i81, write_slab_single1, &
+         write_slab_single2, file_write_block, file_write_block_single
+      procedure, private :: object_attribute_write_string, object_attribute_write_strings
       procedure, private :: read_slab_real1, read_slab_real2, read_slab_int1, read_slab_i81
       procedure, private :: attribute_write_real, attribute_write_int, attribute_write_i8, attribute_write_string, &
          attribute_write_real_array, attribute_write_int_array, attribute_write_i8_array
@@ -65,7 +71,7 @@ module hdf5_file
          attribute_read_real_array, attribute_read_int_array
    end type hdf5_file_t
 
-   public :: distributed_slab, even_slab
+   public :: distributed_slab, even_slab, to_single
 
    logical, save :: library_open = .false.
 
@@ -357,6 +363,16 @@ contains
       call write_block_ptr(self, name, real_type(), global, offset, local, c_loc(values), status)
    end subroutine file_write_block
 
+   !> The same in single precision (a float32 dataset).
+   subroutine file_write_block_single(self, name, global, offset, local, values, status)
+      class(hdf5_file_t), intent(in) :: self
+      character(len=*), intent(in) :: name
+      integer(i8), intent(in) :: global(:), offset(:), local(:)
+      real(real32), intent(in), target, contiguous :: values(:)
+      type(status_t), intent(inout) :: status
+      call write_block_ptr(self, name, single_type(), global, offset, local, c_loc(values), status)
+   end subroutine file_write_block_single
+
    !> Read this rank's block `local` at `offset` of the grid dataset `name` of Fortran shape `global`.
    subroutine file_read_block(self, name, global, offset, local, values, status)
       class(hdf5_file_t), intent(in) :: self
@@ -389,6 +405,44 @@ contains
       call write_block_ptr(self, name, real_type(), [n, slab%total], [0_i8, slab%offset], [n, slab%count], &
                            c_loc(values), status)
    end subroutine write_slab_real2
+
+   !> Single precision: `values(1:slab%count)` into the float32 1-D dataset `name`.
+   subroutine write_slab_single1(self, name, slab, values, status)
+      class(hdf5_file_t), intent(in) :: self
+      character(len=*), intent(in) :: name
+      type(slab_t), intent(in) :: slab
+      real(real32), intent(in), target, contiguous :: values(:)
+      type(status_t), intent(inout) :: status
+      call write_block_ptr(self, name, single_type(), [slab%total], [slab%offset], [slab%count], c_loc(values), status)
+   end subroutine write_slab_single1
+
+   !> Single precision: `values(:, 1:slab%count)` as this rank's rows of the float32 dataset `name`.
+   subroutine write_slab_single2(self, name, slab, values, status)
+      class(hdf5_file_t), intent(in) :: self
+      character(len=*), intent(in) :: name
+      type(slab_t), intent(in) :: slab
+      real(real32), intent(in), target, contiguous :: values(:, :)
+      type(status_t), intent(inout) :: status
+      integer(i8) :: n
+      n = size(values, 1)
+      call write_block_ptr(self, name, single_type(), [n, slab%total], [0_i8, slab%offset], [n, slab%count], &
+                           c_loc(values), status)
+   end subroutine write_slab_single2
+
+   !> `values` rounded to single precision (nearest). A value beyond its range becomes an infinity (the
+   !> state of a blow-up written for inspection): the Debug build's overflow trap is masked meanwhile.
+   function to_single(values) result(single)
+      real(rp), intent(in) :: values(:)
+      real(real32), allocatable :: single(:)
+      type(ieee_flag_type), parameter :: traps(1) = [ieee_overflow]
+      logical :: halting(1)
+      allocate (single(size(values)))
+      call ieee_get_halting_mode(traps, halting)
+      call ieee_set_halting_mode(traps, .false.)
+      single(:) = real(values, real32)
+      call ieee_set_flag(traps, .false.)
+      call ieee_set_halting_mode(traps, halting)
+   end function to_single
 
    subroutine write_slab_int1(self, name, slab, values, status)
       class(hdf5_file_t), intent(in) :: self
@@ -453,7 +507,8 @@ contains
 
    !> Create attribute `name` of the root group holding the `n` values of type `type_id` at `buffer`
    !> (scalar: a scalar attribute of one value).
-   subroutine write_attribute_ptr(self, name, type_id, n, scalar, buffer, status)
+   !> With `location`, the attribute goes to that object (a dataset or group) instead of the root group.
+   subroutine write_attribute_ptr(self, name, type_id, n, scalar, buffer, status, location)
       type(hdf5_file_t), intent(in) :: self
       character(len=*), intent(in) :: name
       integer(hid_t), intent(in) :: type_id
@@ -461,15 +516,18 @@ contains
       logical, intent(in) :: scalar
       type(c_ptr), intent(in) :: buffer
       type(status_t), intent(inout) :: status
-      integer(hid_t) :: space, attribute
+      integer(hid_t), intent(in), optional :: location
+      integer(hid_t) :: space, attribute, owner
       integer :: error, e
       if (.not. status%ok) return
+      owner = self%id
+      if (present(location)) owner = location
       if (scalar) then
          call h5screate_f(H5S_SCALAR_F, space, error)
       else
          call h5screate_simple_f(1, [int(n, hsize_t)], space, error)
       end if
-      call h5acreate_f(self%id, name, type_id, space, attribute, e)
+      call h5acreate_f(owner, name, type_id, space, attribute, e)
       call h5sclose_f(space, error)
       if (e < 0) then
          call status%fail('cannot create attribute '//name//' in '//self%path)
@@ -546,6 +604,51 @@ contains
       call write_attribute_ptr(self, name, string_type, 1, .true., c_loc(text), status)
       call h5tclose_f(string_type, error)
    end subroutine attribute_write_string
+
+   !> String attribute `name` of the dataset or group `object` (e.g. units of /particles/velocity).
+   subroutine object_attribute_write_string(self, object, name, value, status)
+      class(hdf5_file_t), intent(in) :: self
+      character(len=*), intent(in) :: object, name, value
+      type(status_t), intent(inout) :: status
+      call object_attribute_write_strings(self, object, name, [value], status, scalar=.true.)
+   end subroutine object_attribute_write_string
+
+   !> Attribute `name` of `object` holding the strings `values` (fixed length: the longest, blank-padded);
+   !> h5py shows it as an array of bytes, e.g. material_names [b'water', b'wood block'].
+   subroutine object_attribute_write_strings(self, object, name, values, status, scalar)
+      class(hdf5_file_t), intent(in) :: self
+      character(len=*), intent(in) :: object, name, values(:)
+      type(status_t), intent(inout) :: status
+      logical, intent(in), optional :: scalar
+      integer(hid_t) :: string_type, owner
+      integer :: error, n, k, width
+      logical :: one
+      character(kind=c_char), allocatable, target :: text(:)
+      if (.not. status%ok) return
+      one = .false.
+      if (present(scalar)) one = scalar .and. size(values) == 1
+      width = 1
+      do k = 1, size(values)
+         width = max(width, len_trim(values(k)))
+      end do
+      n = size(values)
+      allocate (text(max(1, n) * width))
+      text = ' '
+      do k = 1, n
+         if (len_trim(values(k)) > 0) text((k - 1) * width + 1:(k - 1) * width + len_trim(values(k))) = &
+            transfer(values(k)(1:len_trim(values(k))), text, len_trim(values(k)))
+      end do
+      call h5oopen_f(self%id, object, owner, error)
+      if (error < 0) then
+         call status%fail('cannot open '//object//' of '//self%path//' to write its attribute '//name)
+         return
+      end if
+      call h5tcopy_f(H5T_FORTRAN_S1, string_type, error)
+      call h5tset_size_f(string_type, int(width, size_t), error)
+      call write_attribute_ptr(self, name, string_type, max(1, n), one, c_loc(text), status, owner)
+      call h5tclose_f(string_type, error)
+      call h5oclose_f(owner, error)
+   end subroutine object_attribute_write_strings
 
    !> Open root attribute `name`; fails with a message naming it if it is missing or, when `n` is
    !> given, does not hold exactly n values (n = 1 also accepts a scalar).
@@ -678,6 +781,10 @@ contains
    integer(hid_t) function real_type()
       real_type = h5kind_to_type(real64, H5_REAL_KIND)
    end function real_type
+
+   integer(hid_t) function single_type()
+      single_type = h5kind_to_type(real32, H5_REAL_KIND)
+   end function single_type
 
    integer(hid_t) function int_type()
       int_type = h5kind_to_type(int32, H5_INTEGER_KIND)

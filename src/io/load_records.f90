@@ -8,13 +8,13 @@
 !> no row at t = 0: a row's loads are averages over the interval that ends at its time.
 !>
 !> Layout: the header row first (so every CSV reader sees the column names), then comment lines
-!> starting with '#' (program version, file, scene, units, how to read it), then the rows:
+!> starting with '#' (program, date, ranks, scene, units, how to read it), then the rows:
 !>   pandas.read_csv(path, comment='#')      numpy.genfromtxt(path, delimiter=',', names=True)
 !> A restart cuts each file back to the rows up to the checkpoint's time and continues it.
 module load_records
    use kinds, only: rp, name_len
    use error_status, only: status_t
-   use build_info, only: flotsam_version
+   use provenance, only: written_by, continued_by, current_date, csv_reading_hint
    use mpm_solver, only: solver_t
    use run_progress, only: run_progress_t
    use csv_writer, only: csv_writer_t, keep_rows_through_time
@@ -62,6 +62,7 @@ contains
                end if
                call keep_rows_through_time(path, solver%time, status)
                if (status%ok) call self%files(f)%open(path, '', status, append=.true.)
+               call self%files(f)%write_row(continued_by(solver%step, solver%time, solver%domain%nranks, current_date()))
             else
                call self%files(f)%open(path, header_row(solver, f), status)
                if (status%ok) call write_comments(self%files(f), solver, f)
@@ -174,7 +175,7 @@ contains
          moment = 'N m'
          per_depth = ''
       end if
-      call file%write_row('# written by flotsam '//flotsam_version//' from scene '//trim(solver%scene%source_file))
+      call file%write_row(written_by(solver%domain%nranks, current_date(), solver%scene%source_file))
       select case (f)
       case (file_loads)
          call file%write_row('# loads.csv: force <name>_f* and moment <name>_m* the material exerts on each wall, box '// &
@@ -195,7 +196,6 @@ contains
          call file%write_row('# units: time s; _x _y _z m; _vx _vy _vz m/s; _angle _rx _ry _rz rad; _fx _fy _fz '// &
                              force//per_depth)
       end select
-      call file%write_row("# read with: pandas.read_csv(path, comment='#')  or  "// &
-                          "numpy.genfromtxt(path, delimiter=',', names=True)")
+      call file%write_row(csv_reading_hint)
    end subroutine write_comments
 end module load_records

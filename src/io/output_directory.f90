@@ -11,7 +11,8 @@ module output_directory
    use error_status, only: status_t
    use file_system, only: path_exists, make_directory, remove_file
    use output_layout, only: fields_folder, checkpoint_folder, fields_file, checkpoint_file, particles_xdmf, &
-                            grid_xdmf, latest_checkpoint, temporary_suffix, loads_csv, gauges_csv, bodies_csv
+                            grid_xdmf, latest_checkpoint, temporary_suffix, loads_csv, gauges_csv, bodies_csv, &
+                            scene_nml, previous_scene_nml
    use status_broadcast, only: broadcast_status
    implicit none
    private
@@ -86,8 +87,8 @@ contains
       end if
    end subroutine make_sub_folders
 
-   !> --overwrite: remove what a previous run wrote (its diagnostics, XDMF files, fields files numbered
-   !> 0, 1, ... and the checkpoints up to the latest one).
+   !> --overwrite: remove what a previous run wrote (its diagnostics, XDMF files, load series, scene files,
+   !> fields files numbered 0, 1, ... and the checkpoints up to the latest one).
    subroutine remove_previous_run(dir, status)
       character(len=*), intent(in) :: dir
       type(status_t), intent(inout) :: status
@@ -101,6 +102,12 @@ contains
       call remove(trim(dir)//'/'//loads_csv, removed)
       call remove(trim(dir)//'/'//gauges_csv, removed)
       call remove(trim(dir)//'/'//bodies_csv, removed)
+      call remove(trim(dir)//'/'//scene_nml, removed)
+      index = 1
+      do while (path_exists(trim(dir)//'/'//previous_scene_nml(index)) .and. removed)
+         call remove(trim(dir)//'/'//previous_scene_nml(index), removed)
+         index = index + 1
+      end do
       index = 0
       do
          if (.not. path_exists(trim(dir)//'/'//fields_file(index))) exit

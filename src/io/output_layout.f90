@@ -1,5 +1,6 @@
 !> Names of everything a run writes in its output folder (docs/output.md):
 !>
+!>   scene.nml                        the resolved scene (provenance); scene_<k>.nml: before a restart changed it
 !>   diagnostics.csv                  one row per output time
 !>   particles.xmf, grid.xmf          XDMF time series for ParaView (rank 0)
 !>   fields/fields_<NNNNNN>.h5        particle and grid fields of output number NNNNNN (0 = initial state)
@@ -21,8 +22,10 @@ module output_layout
    character(len=*), parameter, public :: loads_csv = 'loads.csv'
    character(len=*), parameter, public :: gauges_csv = 'gauges.csv'
    character(len=*), parameter, public :: bodies_csv = 'bodies.csv'
+   !> The resolved scene of the run (provenance).
+   character(len=*), parameter, public :: scene_nml = 'scene.nml'
 
-   public :: fields_file, checkpoint_file
+   public :: fields_file, checkpoint_file, previous_scene_nml
 
 contains
 
@@ -39,6 +42,15 @@ contains
       character(len=:), allocatable :: path
       path = checkpoint_folder//'/checkpoint_'//six_digits(sequence)//'.h5'
    end function checkpoint_file
+
+   !> The k-th scene.nml a continued run with a changed scene replaced: scene_<k>.nml (k = 1, 2, ...).
+   pure function previous_scene_nml(k) result(path)
+      integer, intent(in) :: k
+      character(len=:), allocatable :: path
+      character(len=16) :: buffer
+      write (buffer, '(i0)') k
+      path = 'scene_'//trim(buffer)//'.nml'
+   end function previous_scene_nml
 
    !> 42 -> '000042' (more digits when needed).
    pure function six_digits(number) result(text)

@@ -8,6 +8,7 @@
 !> `timing.csv` beside it: the time loop's wall time per phase (phase_timers), one row per phase:
 !>   phase, seconds_max (the slowest rank's), seconds_mean (over the ranks), share (of the mean loop time)
 !> and a last row `total` (seconds_max: the largest of the ranks' sums, not the sum of the maxima).
+!> Both have the CSV layout of every file a run writes: header row, '#' comment lines (provenance, units).
 module run_summary
    use, intrinsic :: iso_fortran_env, only: error_unit
    use kinds, only: rp, i8
@@ -18,6 +19,7 @@ module run_summary
    use input_text, only: int_text, real_text
    use output_layout, only: temporary_suffix
    use file_system, only: rename_path
+   use provenance, only: written_by, current_date, csv_reading_hint
    implicit none
    private
 
@@ -56,6 +58,12 @@ contains
       if (.not. opened(dir, run_summary_file, unit, status)) return
       write (unit, '(a)') 'wall_seconds,steps,particle_steps,particle_steps_per_second_per_core,ranks,'// &
          'peak_memory_bytes,peak_memory_bytes_total,outcome'
+      write (unit, '(a)') written_by(ranks, current_date()), &
+         '# run_summary.csv: what this invocation of flotsam cost (a continued run reports its continuation)', &
+         '# units: wall_seconds s; steps count; particle_steps count (sum over the steps of the particle count); '// &
+         'particle_steps_per_second_per_core 1/s; ranks count; peak_memory_bytes B (the largest rank''s peak '// &
+         'resident set); peak_memory_bytes_total B (all ranks); outcome: finished, blew_up, stopped_by_signal '// &
+         'or failed', csv_reading_hint
       write (unit, '(a)') real_text(wall_seconds)//','//int_text(steps)//','//int_text(particle_steps)//','// &
          real_text(rate)//','//int_text(ranks)//','//int_text(peak(1))//','//int_text(total(1))//','//outcome
       call publish(dir, run_summary_file, unit, status)
@@ -82,6 +90,11 @@ contains
       total = sum(mean)
       if (.not. opened(dir, timing_file, unit, status)) return
       write (unit, '(a)') 'phase,seconds_max,seconds_mean,share'
+      write (unit, '(a)') written_by(ranks, current_date()), &
+         '# timing.csv: wall time of this invocation''s time loop per phase; the last row, total, has the '// &
+         'largest of the ranks'' sums and their mean', &
+         '# units: seconds_max s (the slowest rank''s); seconds_mean s (mean over the ranks); share - (of the '// &
+         'mean total)', csv_reading_hint
       do k = 1, size(seconds)
          write (unit, '(a)') trim(names(k))//','//real_text(largest(k))//','//real_text(mean(k))//','// &
             real_text(merge(mean(k) / total, 0.0_rp, total > 0.0_rp))

@@ -21,7 +21,7 @@ module run_diagnostics
       real(rp) :: max_rank_share = 0.0_rp   !< largest fraction of the particles on one rank (0: none)
    end type diagnostics_t
 
-   public :: compute_diagnostics, diagnostics_header, diagnostics_row
+   public :: compute_diagnostics, diagnostics_header, diagnostics_row, diagnostics_comments
 
 contains
 
@@ -68,6 +68,29 @@ contains
       line = 'time,step,dt,particles,total_mass,kinetic_energy,fluid_volume,h_eq,max_speed,' // &
              'lost_particles,wall_corrections,max_rank_share'
    end function diagnostics_header
+
+   !> The comment lines of diagnostics.csv after the provenance line: what the file holds and its units
+   !> (lines separated by new_line).
+   function diagnostics_comments(dim) result(text)
+      integer, intent(in) :: dim
+      character(len=:), allocatable :: text, mass, energy, volume
+      if (dim == 2) then
+         mass = 'kg/m'
+         energy = 'J/m'
+         volume = 'm^2'
+      else
+         mass = 'kg'
+         energy = 'J'
+         volume = 'm^3'
+      end if
+      text = '# diagnostics.csv: one row per output time (row n describes the state of fields_<n>.h5), sums '// &
+             'and extremes over all particles and ranks'//new_line('a')// &
+             '# units: time s; step -; dt s (time step); particles count; total_mass '//mass// &
+             '; kinetic_energy '//energy//'; fluid_volume '//volume//'; h_eq m (fluid volume / floor size); '// &
+             'max_speed m/s; lost_particles count (left the grid); wall_corrections count (cumulative); '// &
+             'max_rank_share - (largest fraction of the particles on one rank)'
+      if (dim == 2) text = text//'; 2-D plane strain: per metre of thickness'
+   end function diagnostics_comments
 
    !> One CSV row; reals in full precision (g0) so rows can be compared to round-off. The time in the
    !> fewest digits that read back exactly: an output time k x interval prints as 0.3, not 0.30000000000000000.

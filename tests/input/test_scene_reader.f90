@@ -6,13 +6,14 @@ module test_scene_reader
    use kinds, only: rp
    use assertions, only: assertEqual, assertTrue, assertFalse
    use error_status, only: status_t
-   use scene_description, only: scene_t
+   use scene_description, only: scene_t, writes_particle_field
    use scene_reader, only: read_scene, scene_override_t
+   use scene_record, only: scene_namelist_text
    implicit none
    private
 
    public :: test_default_names_are_resolved, test_gauges_arrive_on_every_rank, test_override_selects_wall_by_name, &
-             test_name_clash_fails_on_every_rank
+             test_name_clash_fails_on_every_rank, test_resolved_text_reads_back, test_particle_fields_list
 
    !> The scene of every test: named and unnamed box sides, walls, bodies and an inlet, three gauge kinds
    !> and a gauge that shares a wall's name (gauges.csv is a file of its own).
@@ -137,4 +138,75 @@ contains
                        'already used by the 2nd &wall', trim(status%message), 'message')
       call assertFalse(allocated(scene%gauges), 'no scene on failure')
    end subroutine test_name_clash_fails_on_every_rank
+
+   !> The resolved scene's text (scene.nml of the output folder), read as a scene file, gives the same
+   !> scene: the same text again, and the values that were derived (names, radii, moment points) as given.
+   subroutine test_resolved_text_reads_back(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(scene_t) :: scene, again
+      type(status_t) :: status
+      type(scene_override_t) :: overrides(1)
+      character(len=:), allocatable :: text
+      integer :: rank, unit
+
+      call write_scene_file(comm)
+      overrides(1) = scene_override_t("&material name = 'block', poisson_ratio = 0.1234567890123 / "// &
+                                      "&run field_precision = 'Single', particle_fields = 'pressure, id' /", .true.)
+      call read_scene(scene_file, comm, scene, status, overrides)
+      call assertTrue(status%ok, 'read_scene: '//trim(status%message))
+      if (.not. status%ok) return
+      text = scene_namelist_text(scene)
+      call MPI_Comm_rank(comm, rank)
+      if (rank == 0) then
+         open (newunit=unit, file='resolved_scene.nml', status='replace', action='write')
+         write (unit, '(a)', advance='no') text
+         close (unit)
+      end if
+      call MPI_Barrier(comm)
+      call read_scene('resolved_scene.nml', comm, again, status)
+      call assertTrue(status%ok, 'the resolved text reads as a scene: '//trim(status%message))
+      if (.not. status%ok) return
+      call assertTrue(scene_namelist_text(again) == text, 'the same text again')
+      call assertEqual('single', trim(again%run%field_precision), 'field_precision')
+      call assertEqual('pressure,id', trim(again%run%particle_fields), 'particle_fields without blanks')
+      call assertEqual(0.1234567890123_rp, again%materials(2)%poisson_ratio, 'a real exactly')
+      call assertEqual(scene%run%output_interval, again%run%output_interval, 'resolved output_interval')
+      call assertEqual(scene%gauges(1)%radius, again%gauges(1)%radius, 'resolved gauge radius')
+      call assertEqual(scene%walls(3)%moment_point, again%walls(3)%moment_point, 'resolved moment point')
+      call assertEqual(scene%inlets(1)%end_time, again%inlets(1)%end_time, 'inlet end_time (huge: never closes)')
+      call assertEqual(scene%grid%rotation, again%grid%rotation, 'rotation')
+      call assertEqual('wall_3', trim(again%walls(3)%name), 'default name written')
+      call assertEqual(0, index(text, 'overwrite'), 'overwrite is not part of the text')
+   end subroutine test_resolved_text_reads_back
+
+   !> `&run particle_fields`: names without blanks, in any case; 'all' (the default) selects every one.
+   subroutine test_particle_fields_list(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(scene_t) :: scene
+      type(status_t) :: status
+      type(scene_override_t) :: overrides(1)
+
+      call write_scene_file(comm)
+      call read_scene(scene_file, comm, scene, status)
+      call assertTrue(status%ok, 'read_scene: '//trim(status%message))
+      if (.not. status%ok) return
+      call assertEqual('all', trim(scene%run%particle_fields), 'default')
+      call assertEqual('double', trim(scene%run%field_precision), 'default precision')
+      call assertTrue(writes_particle_field(scene%run, 'stress'), 'all: stress')
+      overrides(1) = scene_override_t("&run particle_fields = ' Velocity , Mean_Stress,rank' /", .true.)
+      call read_scene(scene_file, comm, scene, status, overrides)
+      call assertTrue(status%ok, 'read_scene: '//trim(status%message))
+      if (.not. status%ok) return
+      call assertEqual('velocity,mean_stress,rank', trim(scene%run%particle_fields), 'normalised')
+      call assertTrue(writes_particle_field(scene%run, 'velocity'), 'first')
+      call assertTrue(writes_particle_field(scene%run, 'mean_stress'), 'middle')
+      call assertTrue(writes_particle_field(scene%run, 'rank'), 'last')
+      call assertFalse(writes_particle_field(scene%run, 'stress'), 'stress not chosen')
+      call assertFalse(writes_particle_field(scene%run, 'mean'), 'no prefix match')
+      overrides(1) = scene_override_t("&run particle_fields = 'velocity,pressur' /", .true.)
+      call read_scene(scene_file, comm, scene, status, overrides)
+      call assertFalse(status%ok, 'unknown field refused')
+      call assertTrue(index(status%message, "group &run: variable particle_fields: unknown field 'pressur'") > 0, &
+                      trim(status%message))
+   end subroutine test_particle_fields_list
 end module test_scene_reader

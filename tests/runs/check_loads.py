@@ -226,7 +226,7 @@ def check_restart(checks, flotsam_path, mpiexec, scenes):
     result = full.run("scene.nml", 2)
     if not checks.check(result.returncode == 0, "restart: the uninterrupted run", result.stderr[-2000:]):
         return None
-    steps = int(pd.read_csv(full.path("out", "diagnostics.csv"))["step"].iloc[-1])
+    steps = int(pd.read_csv(full.path("out", "diagnostics.csv"), comment="#")["step"].iloc[-1])
 
     # the latest checkpoint before half-way that lies inside a load interval (the accumulated impulse must
     # carry over); the second run stops 10 steps after it, at max_steps, and is continued from it
@@ -245,7 +245,7 @@ def check_restart(checks, flotsam_path, mpiexec, scenes):
     if not checks.check(result.returncode == 0, f"restart: the run stopped at max_steps = {stop} of {steps}",
                         result.stderr[-2000:]):
         return full.path("out")
-    checks.check(int(pd.read_csv(split.path("out", "diagnostics.csv"))["step"].iloc[-1]) == stop,
+    checks.check(int(pd.read_csv(split.path("out", "diagnostics.csv"), comment="#")["step"].iloc[-1]) == stop,
                  f"restart: stopped at step {stop}")
     with h5py.File(split.path("out", "checkpoints", checkpoint_name)) as f:
         same = (int(f.attrs["step"]), float(f.attrs["time"])) == (step, time)
@@ -256,17 +256,31 @@ def check_restart(checks, flotsam_path, mpiexec, scenes):
     result = split.run("continue.nml", 2, "--restart", checkpoint)
     checks.check(result.returncode == 0, f"restart: continued from step {step} to the end", result.stderr[-2000:])
     for file in FILES:
-        with open(full.path("out", file + ".csv"), "rb") as f:
-            expected = f.read()
+        with open(full.path("out", file + ".csv")) as f:
+            expected = f.read().splitlines()
         path = split.path("out", file + ".csv")
-        actual = b""
+        actual = []
         if os.path.exists(path):
-            with open(path, "rb") as f:
-                actual = f.read()
-        checks.check(actual == expected and len(expected) > 0,
-                     f"restart: {file}.csv byte for byte that of the uninterrupted run "
-                     f"({len(expected.splitlines())} lines)",
-                     f"{len(actual.splitlines())} lines against {len(expected.splitlines())}")
+            with open(path) as f:
+                actual = f.read().splitlines()
+        # the '#' lines name each invocation's date; the continuation adds one where it starts
+        rows = [line for line in actual if not line.startswith("#")]
+        expected_rows = [line for line in expected if not line.startswith("#")]
+        checks.check(rows == expected_rows and len(expected_rows) > 1,
+                     f"restart: {file}.csv rows byte for byte those of the uninterrupted run "
+                     f"({len(expected_rows)} lines)", f"{len(rows)} lines against {len(expected_rows)}")
+        comments = [line for line in actual if line.startswith("#")]
+        expected_comments = [line for line in expected if line.startswith("#")]
+        continued = [k for k, line in enumerate(actual) if line.startswith("# continued from the checkpoint at step")]
+        before = [float(line.split(",")[0]) for line in actual[1:continued[0]] if not line.startswith("#")] \
+            if continued else []
+        after = [float(line.split(",")[0]) for line in actual[continued[0] + 1:] if not line.startswith("#")] \
+            if continued else []
+        checks.check(len(comments) == len(expected_comments) + 1 and len(continued) == 1 and
+                     f"step {step} " in actual[continued[0]] and all(t <= time for t in before) and
+                     len(after) > 0 and all(t > time for t in after),
+                     f"restart: {file}.csv says where the continuation from step {step} starts",
+                     "\n".join(comments))
     return full.path("out")
 
 

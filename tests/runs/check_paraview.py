@@ -30,7 +30,7 @@ from flotsam_run import Checks, Flotsam, PrivateDisplay, main_arguments, read_di
 
 PROBE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "paraview_probe.py")
 
-PARTICLE_ARRAYS = {"position": 3, "velocity": 3, "mass": 1, "volume": 1, "density": 1, "stress": 9, "mean_stress": 1,
+PARTICLE_ARRAYS = {"position": 3, "velocity": 3, "mass": 1, "volume": 1, "density": 1, "stress": 9, "mean_stress": 1, "pressure": 1,
                    "material": 1, "id": 1, "rank": 1}
 GRID_POINT_ARRAYS = {"mass": 1, "velocity": 3}
 GRID_CELL_ARRAYS = {"density_water": 1, "mean_stress_water": 1, "density_wood_block": 1,

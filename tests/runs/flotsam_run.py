@@ -135,7 +135,14 @@ def signal_ranks(process, signum):
 def read_diagnostics(output_dir):
     """The rows of diagnostics.csv as dictionaries of strings (exact text, for bitwise comparisons)."""
     with open(os.path.join(output_dir, "diagnostics.csv")) as f:
-        return list(csv.DictReader(f))
+        return list(csv.DictReader(line for line in f if not line.startswith("#")))
+
+
+def csv_data_lines(path):
+    """The header and the rows of a CSV file a run wrote, without its '#' comment lines (which carry
+    the date and the invocation, so they differ between two runs with the same results)."""
+    with open(path) as f:
+        return [line for line in f.read().splitlines() if not line.startswith("#")]
 
 
 class PrivateDisplay:
@@ -193,5 +200,4 @@ def main_arguments():
 
 
 __all__ = ["Checks", "Flotsam", "PrivateDisplay", "child_pids", "wait_for_file", "signal_ranks", "read_diagnostics",
-           "signal",
-           "main_arguments"]
+           "csv_data_lines", "signal", "main_arguments"]
