@@ -15,7 +15,7 @@ import shlex
 import subprocess
 import time
 
-from flotsam_run import Checks, Flotsam, main_arguments, read_diagnostics
+from flotsam_run import Checks, Flotsam, csv_data_lines, main_arguments, read_diagnostics
 
 RANKS = 2
 
@@ -74,8 +74,7 @@ def main():
         checks.check(last.startswith("flotsam: end of run: finished, ") and " steps to t = 0.3 s in " in last
                      and "s wall time, " in last and last.endswith(" particle-steps/s"),
                      "final line: outcome, steps, simulated time, wall time, particle-steps/s", last)
-        with open(flotsam.path("times", "diagnostics.csv")) as f:
-            times = [line.split(",")[0] for line in f.read().splitlines()[1:]]
+        times = [line.split(",")[0] for line in csv_data_lines(flotsam.path("times", "diagnostics.csv"))[1:]]
         checks.check(times == ["0.0", "0.1", "0.2", "0.3"], "diagnostics.csv times are 0.0, 0.1, 0.2, 0.3 exactly",
                      str(times))
         rows = read_diagnostics(flotsam.path("times"))

@@ -397,9 +397,9 @@ def check_single_precision(checks, flotsam, scenes):
     with meshio.xdmf.TimeSeriesReader(os.path.join(directory, "particles.xmf")) as reader:
         reader.read_points_cells()
         _, point_data, _ = reader.read_data(reader.num_steps - 1)
-        checks.check(set(point_data) == {"velocity", "pressure", "material"} and
+        checks.check(set(point_data) == {"position", "velocity", "pressure", "material"} and
                      point_data["pressure"].dtype == np.float32,
-                     f"{name} particles.xmf: meshio reads the three arrays, pressure as float32",
+                     f"{name} particles.xmf: meshio reads the three arrays and the positions, pressure as float32",
                      f"{ {k: str(v.dtype) for k, v in point_data.items()} }")
 
     # a continuation may not change the fields; one with a later end_time keeps the previous scene.nml
