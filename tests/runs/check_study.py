@@ -46,11 +46,15 @@ def ranks_of(process, flotsam):
     return ranks
 
 
-def wait_for(path, process, timeout=120):
+def wait_for_rows(path, process, rows=2, timeout=300):
+    """Wait until diagnostics.csv `path` has `rows` rows after the initial one: the time loop runs, and
+    flotsam's signal handlers are installed (after the initial output). False if the run ended first."""
     start = time.time()
     while time.time() - start < timeout and process.poll() is None:
         if os.path.exists(path):
-            return True
+            with open(path) as f:
+                if sum(1 for line in f if line.strip() and not line.startswith("#")) >= rows + 2:
+                    return True
         time.sleep(0.05)
     return False
 
@@ -160,8 +164,7 @@ def main():
     for number, how in ((1, "ranks"), (2, "study")):
         process = subprocess.Popen(long_base + ["--case", str(number)], stdout=subprocess.PIPE,
                                    stderr=subprocess.PIPE, text=True)
-        started = wait_for(os.path.join(folders[number - 1], "diagnostics.csv"), process)
-        time.sleep(0.5)
+        started = wait_for_rows(os.path.join(folders[number - 1], "diagnostics.csv"), process)
         if how == "ranks":         # a batch system's SIGTERM to the job's processes
             for pid in ranks_of(process, flotsam_path):
                 os.kill(pid, signal.SIGTERM)
