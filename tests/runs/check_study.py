@@ -46,7 +46,7 @@ def ranks_of(process, flotsam):
     return ranks
 
 
-def wait_for_rows(path, process, rows=2, timeout=300):
+def wait_for_rows(path, process, rows=1, timeout=300):
     """Wait until diagnostics.csv `path` has `rows` rows after the initial one: the time loop runs, and
     flotsam's signal handlers are installed (after the initial output). False if the run ended first."""
     start = time.time()
@@ -156,7 +156,7 @@ def main():
     # --- stopped cases are continued from their checkpoints --------------------------------------------
     long_study = os.path.join(work, "long.study")
     long_out = os.path.join(work, "long")
-    steps = 3000
+    steps = 2000
     write_study(long_study, scene, long_out, f'material:water stabilization = ["C0", "NB"]\nrun max_steps = [{steps}]')
     long_base = [sys.executable, os.path.join(scripts, "study"), long_study, "--flotsam", flotsam_path,
                  "--mpiexec", mpiexec]
