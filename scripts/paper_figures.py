@@ -55,7 +55,8 @@ def run_case(name, source, changes, ranks, end_time):
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
                OMPI_MCA_rmaps_base_oversubscribe="1")
     start = time.time()
-    result = subprocess.run(["mpirun", "-np", str(ranks), FLOTSAM, scene], env=env, capture_output=True, text=True)
+    launcher = os.environ.get("FLOTSAM_MPIEXEC") or "mpirun"      # the build's MPI (docs/cluster.md)
+    result = subprocess.run([launcher, "-np", str(ranks), FLOTSAM, scene], env=env, capture_output=True, text=True)
     seconds = time.time() - start
     rows = diagnostics(folder)
     summary.setdefault("runs", {})[name] = {"exit": result.returncode, "wall_seconds": round(seconds, 1),

@@ -78,7 +78,7 @@ def block_cases(quick):
 
 
 def run(flotsam, ranks, scene, overrides, folder):
-    command = ["mpirun", "-np", str(ranks), flotsam, scene]
+    command = [os.environ.get("FLOTSAM_MPIEXEC") or "mpirun", "-np", str(ranks), flotsam, scene]
     for text in overrides + [f"&run output_dir = '{folder}', overwrite = .true., progress_interval = 0.0, "
                              "checkpoint_interval_wall = 0.0 /"]:
         command += ["--set", text]

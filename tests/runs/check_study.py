@@ -1,54 +1,121 @@
 #!/usr/bin/python3
-"""scripts/study on a small study of the hydrostatic tank (2 x 2 cases of a few steps): every case
-runs once, a second call runs nothing again (resumable), results.csv has a row per case with its
-parameters, cost and accuracy columns, and pareto.png is written; a bad study file is refused.
+"""scripts/study on small studies of the hydrostatic tank:
+  * 2 x 2 cases of 20 steps, 2 at once (--jobs 2): each case prints a line when it starts and when it
+    ends; results.csv has a row per case with its parameters, cost and accuracy columns; pareto.png;
+  * a second call runs nothing again (resumed), --case N runs (here: finds done) case N only;
+  * the base scene changed: a case is not reused but run again, its old folder moved to superseded/
+    (or, with --stale refuse, the study stops and the folder stays as it was);
+  * a case stopped by SIGTERM to its ranks (what a batch system sends), and one whose study got
+    SIGTERM (the study passes SIGUSR1 on to the case), are not done: the study exits with 5, and the
+    next call continues them from their checkpoints; their cost adds up both invocations;
+  * --report tabulates the cases that are done without running anything; a bad study file is refused.
 
 usage: check_study.py <flotsam> <mpiexec> <tests/runs/scenes> <scripts folder>"""
 
 import csv
+import glob
 import os
 import shutil
+import signal
 import subprocess
 import sys
+import time
 
-from flotsam_run import Checks, main_arguments
+from flotsam_run import Checks, child_pids, main_arguments, read_diagnostics
+
+
+
+def ended(line):
+    """A study line saying a case ran to its end: to end_time (finished) or to its max_steps."""
+    return ": finished, " in line or ": max_steps, " in line
+
+
+def descendants(pid):
+    found, todo = [], [pid]
+    while todo:
+        children = child_pids(todo.pop())
+        found += children
+        todo += children
+    return found
+
+
+def ranks_of(process, flotsam):
+    """The flotsam processes below `process` (the study, its mpiexec, the launcher's proxies)."""
+    ranks = []
+    for pid in descendants(process.pid):
+        try:
+            with open(f"/proc/{pid}/cmdline", "rb") as f:
+                if f.read().split(b"\0")[0].decode() == flotsam:
+                    ranks.append(pid)
+        except OSError:
+            pass
+    return ranks
+
+
+def wait_for_rows(path, process, rows=1, timeout=300):
+    """Wait until diagnostics.csv `path` has `rows` rows after the initial one: the time loop runs, and
+    flotsam's signal handlers are installed (after the initial output). False if the run ended first."""
+    start = time.time()
+    while time.time() - start < timeout and process.poll() is None:
+        if os.path.exists(path):
+            with open(path) as f:
+                if sum(1 for line in f if line.strip() and not line.startswith("#")) >= rows + 2:
+                    return True
+        time.sleep(0.05)
+    return False
+
+
+def read_results(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def write_study(path, scene, output, parameters):
+    with open(path, "w") as f:
+        f.write(f"[study]\nscene = {scene}\nranks = 2\noutput = {output}\n[parameters]\n{parameters}\n"
+                "[hydrostatic]\ndensity = 1000.0\ngravity = 10.0\n")
 
 
 def main():
-    flotsam_path, _mpiexec, _scenes, rest = main_arguments()
+    flotsam_path, mpiexec, _scenes, rest = main_arguments()
+    flotsam_path = os.path.abspath(flotsam_path)
     scripts = os.path.abspath(rest[0])
     inputs = os.path.join(os.path.dirname(scripts), "inputs")
     checks = Checks()
     work = os.path.abspath("study")
     shutil.rmtree(work, ignore_errors=True)       # a clean start: the study would resume a previous one
     os.makedirs(work)
+    scene = os.path.join(work, "tank.nml")        # a copy: changed below
+    shutil.copy(os.path.join(inputs, "hydrostatic_tank.nml"), scene)
     study = os.path.join(work, "small.study")
-    with open(study, "w") as f:
-        f.write(f"""[study]
-scene = {os.path.join(inputs, "hydrostatic_tank.nml")}
-ranks = 2
-output = {os.path.join(work, "out")}
-[parameters]
-material:water stabilization = ["C0", "NB"]
-grid rotation = [0.0, 45.0]
-run max_steps = [20]
-[hydrostatic]
-density = 1000.0
-gravity = 10.0
-""")
-    command = [sys.executable, os.path.join(scripts, "study"), study, "--flotsam", flotsam_path]
-    first = subprocess.run(command, capture_output=True, text=True)
-    checks.check(first.returncode == 0, "the study runs", first.stderr[-1500:])
-    # each case stops at its max_steps (the outcome run_summary.csv names)
-    checks.check(first.stdout.count(": max_steps, ") == 4 and "done before" not in first.stdout, "4 cases run",
+    out = os.path.join(work, "out")
+    write_study(study, scene, out, 'material:water stabilization = ["C0", "NB"]\ngrid rotation = [0.0, 45.0]\n'
+                "run max_steps = [20]")
+    base = [sys.executable, os.path.join(scripts, "study"), study, "--flotsam", flotsam_path, "--mpiexec", mpiexec]
+
+    def run(*arguments):
+        return subprocess.run(base + list(arguments), capture_output=True, text=True)
+
+    first = run("--jobs", "2")
+    checks.check(first.returncode == 0, "the study runs (--jobs 2)", first.stderr[-1500:])
+    lines = first.stdout.splitlines()
+    checks.check(sum(line.endswith(": started") for line in lines) == 4 and
+                 sum(ended(line) and "(exit 0)" in line for line in lines) == 4 and
+                 "done before" not in first.stdout, "4 cases run, a line as each starts and ends", first.stdout)
+    # with 2 at once, the second case starts before the first ends
+    starts = [i for i, line in enumerate(lines) if line.endswith(": started")]
+    ends = [i for i, line in enumerate(lines) if "(exit 0)" in line]
+    checks.check(len(starts) == 4 and len(ends) == 4 and starts[1] < ends[0], "--jobs 2: two cases at once",
                  first.stdout)
-    second = subprocess.run(command, capture_output=True, text=True)
-    checks.check(second.returncode == 0 and second.stdout.count("done before") == 4, "resumed: nothing run again",
-                 second.stdout)
-    results = os.path.join(work, "out", "results.csv")
+    second = run()
+    checks.check(second.returncode == 0 and second.stdout.count("done before") == 4 and "started" not in second.stdout,
+                 "resumed: nothing run again", second.stdout)
+    one = run("--case", "2")
+    checks.check(one.returncode == 0 and one.stdout.count("done before") == 1 and "[2/4]" in one.stdout,
+                 "--case 2: that case only", one.stdout)
+    results = os.path.join(out, "results.csv")
     if checks.check(os.path.exists(results), "results.csv written"):
-        with open(results) as f:
-            rows = list(csv.DictReader(f))
+        rows = read_results(results)
         checks.check(len(rows) == 4, "one row per case", str(len(rows)))
         needed = ["case", "material:water stabilization", "grid rotation", "wall_seconds", "steps",
                   "particle_steps_per_second_per_core", "peak_memory_bytes", "outcome", "h_eq_drift_percent",
@@ -61,7 +128,73 @@ gravity = 10.0
         # RMS h / (sqrt(12) H) = 0.4 / (sqrt(12) 3.2) = 0.036
         checks.check(len(aligned) == 1 and abs(float(aligned[0]["pressure_rms_error_relative"]) - 0.036) < 0.003,
                      "aligned tank, C0: pressure error = the cell-averaging error", str(aligned))
-    checks.check(os.path.exists(os.path.join(work, "out", "pareto.png")), "pareto.png written")
+    checks.check(os.path.exists(os.path.join(out, "pareto.png")), "pareto.png written")
+
+    # --- the base scene changes: nothing stale is reused ------------------------------------------------
+    with open(scene) as f:
+        text = f.read()
+    with open(scene, "w") as f:
+        f.write(text.replace("end_time = 3.0", "end_time = 2.0"))
+    case1 = os.path.join(out, "cases", rows[0]["case"]) if os.path.exists(results) else ""
+    with open(os.path.join(case1, "run_summary.csv")) as f:
+        summary_before = f.read()
+    refused = run("--case", "1", "--stale", "refuse")
+    checks.check(refused.returncode == 1 and "changed since its run: the scene file" in refused.stderr and
+                 "started" not in refused.stdout, "scene changed, --stale refuse: stops, names the change",
+                 refused.stdout + refused.stderr)
+    with open(os.path.join(case1, "run_summary.csv")) as f:
+        checks.check(f.read() == summary_before, "--stale refuse: the case folder untouched")
+    moved = run("--case", "1")
+    aside = os.path.join(out, "superseded", rows[0]["case"] + ".1")
+    checks.check(moved.returncode == 0 and "changed since its run: the scene file: moved to " + aside in moved.stdout
+                 and "done before" not in moved.stdout and any(ended(line) for line in moved.stdout.splitlines()),
+                 "scene changed: the case runs again, its old folder moved aside", moved.stdout + moved.stderr)
+    if os.path.exists(os.path.join(aside, "run_summary.csv")):
+        with open(os.path.join(aside, "run_summary.csv")) as f:
+            checks.check(f.read() == summary_before, "superseded/: the old results kept as they were")
+    else:
+        checks.check(False, "superseded/: the old results kept as they were", aside)
+    report = run("--report")
+    checks.check(report.returncode == 0 and "wrote" in report.stdout and "(1 of 4 cases)" in report.stdout and
+                 report.stdout.count("run with another key (stale)") == 3 and "started" not in report.stdout,
+                 "--report: only the case run with the changed scene is tabulated", report.stdout + report.stderr)
+
+    # --- stopped cases are continued from their checkpoints --------------------------------------------
+    long_study = os.path.join(work, "long.study")
+    long_out = os.path.join(work, "long")
+    steps = 2000
+    write_study(long_study, scene, long_out, f'material:water stabilization = ["C0", "NB"]\nrun max_steps = [{steps}]')
+    long_base = [sys.executable, os.path.join(scripts, "study"), long_study, "--flotsam", flotsam_path,
+                 "--mpiexec", mpiexec]
+    folders = [os.path.join(long_out, "cases", f"stabilization-{s}_max_steps-{steps}") for s in ("C0", "NB")]
+    for number, how in ((1, "ranks"), (2, "study")):
+        process = subprocess.Popen(long_base + ["--case", str(number)], stdout=subprocess.PIPE,
+                                   stderr=subprocess.PIPE, text=True)
+        started = wait_for_rows(os.path.join(folders[number - 1], "diagnostics.csv"), process)
+        if how == "ranks":         # a batch system's SIGTERM to the job's processes
+            for pid in ranks_of(process, flotsam_path):
+                os.kill(pid, signal.SIGTERM)
+        else:                      # SIGTERM to the study only: it passes SIGUSR1 on to its case
+            process.send_signal(signal.SIGTERM)
+        stdout, stderr = process.communicate(timeout=300)
+        checks.check(started and process.returncode == 5 and "stopped_by_signal" in stdout and not any(ended(line) for line in stdout.splitlines()),
+                     f"case {number} stopped (SIGTERM to the {how}): the study exits with 5",
+                     f"{process.returncode}: {stdout} {stderr[-800:]}")
+    again = subprocess.run(long_base, capture_output=True, text=True)
+    checks.check(again.returncode == 0 and again.stdout.count("continuing from checkpoints/checkpoint_") == 2 and
+                 sum(ended(line) for line in again.stdout.splitlines()) == 2 and "done before" not in again.stdout,
+                 "the stopped cases continue from their checkpoints", again.stdout + again.stderr[-800:])
+    long_results = os.path.join(long_out, "results.csv")
+    if checks.check(os.path.exists(long_results), "results of the continued cases"):
+        rows = read_results(long_results)
+        checks.check(len(rows) == 2 and all(r["steps"] == str(steps) and r["invocations"] == "2" and
+                                            r["outcome"] in ("finished", "max_steps") for r in rows),
+                     f"cost of a continued case: its {steps} steps over 2 invocations", str(rows))
+        last = [read_diagnostics(folder)[-1] for folder in folders]
+        checks.check(all(int(row["step"]) == steps for row in last), "the continued runs reached their last step",
+                     str([row["step"] for row in last]))
+    third = subprocess.run(long_base, capture_output=True, text=True)
+    checks.check(third.returncode == 0 and third.stdout.count("done before") == 2, "then done", third.stdout)
 
     with open(os.path.join(work, "bad.study"), "w") as f:
         f.write("[study]\nscene = nowhere.nml\n[parameters]\ngrid rotation = [0.0]\n")
@@ -69,6 +202,11 @@ gravity = 10.0
                           "--flotsam", flotsam_path], capture_output=True, text=True)
     checks.check(bad.returncode != 0 and "nowhere.nml not found" in bad.stderr, "a bad study file is refused",
                  bad.stderr)
+    bad_case = run("--case", "9")
+    checks.check(bad_case.returncode != 0 and "--case 9: the study has cases 1 to 4" in bad_case.stderr,
+                 "--case out of range is refused", bad_case.stderr)
+    leftovers = glob.glob(os.path.join(work, "**", "*.tmp"), recursive=True)
+    checks.check(not leftovers, "no temporary files left", str(leftovers))
     raise SystemExit(checks.summary())
 
 

@@ -121,9 +121,20 @@ def wait_for_file(path, process, timeout=120):
     return False
 
 
+def rank_pids(pid):
+    """The ranks started by the launcher `pid`: its descendants that have no children of their own
+    (Open MPI's mpirun starts local ranks itself; MPICH's mpiexec through hydra_pmi_proxy)."""
+    ranks, todo = [], [pid]
+    while todo:
+        children = child_pids(todo.pop())
+        for child in children:
+            (todo if child_pids(child) else ranks).append(child)
+    return ranks
+
+
 def signal_ranks(process, signum):
     """Send `signum` to every rank of the mpirun `process` (what a batch system does to a job step)."""
-    pids = child_pids(process.pid)
+    pids = rank_pids(process.pid)
     for pid in pids:
         try:
             os.kill(pid, signum)
@@ -199,5 +210,5 @@ def main_arguments():
     return sys.argv[1], sys.argv[2], os.path.abspath(sys.argv[3]), sys.argv[4:]
 
 
-__all__ = ["Checks", "Flotsam", "PrivateDisplay", "child_pids", "wait_for_file", "signal_ranks", "read_diagnostics",
-           "csv_data_lines", "signal", "main_arguments"]
+__all__ = ["Checks", "Flotsam", "PrivateDisplay", "child_pids", "rank_pids", "wait_for_file", "signal_ranks",
+           "read_diagnostics", "csv_data_lines", "signal", "main_arguments"]
