@@ -21,7 +21,7 @@ module scene_reader
    implicit none
    private
 
-   public :: read_scene, group_variables
+   public :: read_scene, group_variables, entry_count
 
    !> A layer applied on top of the scene file: another namelist file, or namelist text from the command
    !> line (`--set '&grid rotation = 45 /'`). Singleton groups change the variables they assign; a
@@ -363,9 +363,12 @@ contains
       end select
    end function selected_value
 
+   !> Entries of `group` in the scene: 1 for a singleton group.
    pure integer function entry_count(scene, group) result(n)
       type(scene_t), intent(in) :: scene
       character(len=*), intent(in) :: group
+      n = 1
+      if (.not. any(repeated_groups == group)) return
       n = 0
       select case (group)
       case ('material')

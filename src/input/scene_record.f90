@@ -10,7 +10,7 @@
 module scene_record
    use kinds, only: rp
    use scene_description, only: scene_t
-   use scene_reader, only: known_groups, repeated_groups, group_variables
+   use scene_reader, only: known_groups, group_variables, entry_count
    use input_text, only: int_text, real_text
    implicit none
    private
@@ -58,27 +58,6 @@ contains
          text = text//groups(g)%text//new_line('a')
       end do
    end function scene_namelist_text
-
-   !> Entries of `group` in the scene: 1 for a singleton group.
-   pure integer function entry_count(scene, group) result(n)
-      type(scene_t), intent(in) :: scene
-      character(len=*), intent(in) :: group
-      n = 1
-      if (.not. any(repeated_groups == group)) return
-      n = 0
-      select case (group)
-      case ('material')
-         if (allocated(scene%materials)) n = size(scene%materials)
-      case ('body')
-         if (allocated(scene%bodies)) n = size(scene%bodies)
-      case ('wall')
-         if (allocated(scene%walls)) n = size(scene%walls)
-      case ('inlet')
-         if (allocated(scene%inlets)) n = size(scene%inlets)
-      case ('gauge')
-         if (allocated(scene%gauges)) n = size(scene%gauges)
-      end select
-   end function entry_count
 
    !> Entry k of `group`: every variable the reader knows for it, in its order.
    function group_text(scene, group, k) result(text)
