@@ -62,7 +62,7 @@ contains
          '# run_summary.csv: what this invocation of flotsam cost (a continued run reports its continuation)', &
          '# units: wall_seconds s; steps count; particle_steps count (sum over the steps of the particle count); '// &
          'particle_steps_per_second_per_core 1/s; ranks count; peak_memory_bytes B (the largest rank''s peak '// &
-         'resident set); peak_memory_bytes_total B (all ranks); outcome: finished, blew_up, stopped_by_signal '// &
+         'resident set); peak_memory_bytes_total B (all ranks); outcome: finished, max_steps, blew_up, stopped_by_signal '// &
          'or failed', csv_reading_hint
       write (unit, '(a)') real_text(wall_seconds)//','//int_text(steps)//','//int_text(particle_steps)//','// &
          real_text(rate)//','//int_text(ranks)//','//int_text(peak(1))//','//int_text(total(1))//','//outcome

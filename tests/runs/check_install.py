@@ -54,7 +54,8 @@ def main():
     ok = run.returncode == 0 and os.path.exists(summary)
     if ok:
         with open(summary) as f:
-            ok = list(csv.DictReader(f))[0]["outcome"] == "finished"
+            rows = list(csv.DictReader(line for line in f if not line.startswith("#")))
+            ok = rows[0]["outcome"] in ("finished", "max_steps")
     checks.check(ok, "the installed flotsam runs an installed scene from another folder", run.stderr[-1500:])
     plot = subprocess.run([os.path.join(prefix, "bin", "flotsam-plot-diagnostics"), "run", "-o", "d.png"],
                           cwd=elsewhere, env=environment, capture_output=True, text=True)
@@ -70,7 +71,7 @@ def main():
     if os.path.exists(record_path):
         with open(record_path) as f:
             command = json.load(f)["attempts"][-1]["command"]
-    checks.check(study.returncode == 0 and "finished" in study.stdout and command[:1] == [mpiexec]
+    checks.check(study.returncode == 0 and (": finished, " in study.stdout or ": max_steps, " in study.stdout) and command[:1] == [mpiexec]
                  and command[3:4] == [flotsam], "flotsam-study runs the installed flotsam with the build's launcher",
                  f"{study.stdout}{study.stderr[-1000:]} {command[:4]}")
     raise SystemExit(checks.summary())

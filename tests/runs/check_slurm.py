@@ -143,7 +143,7 @@ def main():
     process = job("study.sbatch", [study], 201, SLURM_ARRAY_TASK_ID="2", SLURM_ARRAY_JOB_ID="199",
                   FLOTSAM_STUDY=study_script, FLOTSAM_JOB_NUMBER="2")
     log, _ = process.communicate(timeout=600)
-    checks.check(process.returncode == 0 and "continuing from checkpoints/" in log and "finished" in log and
+    checks.check(process.returncode == 0 and "continuing from checkpoints/" in log and (": finished, " in log or ": max_steps, " in log) and
                  "[2/2]" in log and not os.path.exists(os.path.join(work, "study_out", "cases",
                                                                      f"stabilization-C0_max_steps-{steps}")),
                  "study.sbatch: the follow-up finishes case 2, and only case 2", log)
