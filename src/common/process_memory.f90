@@ -40,23 +40,37 @@ contains
    !> The value of a `Name:   1234 kB` line of file `path` in bytes; -1 if there is none.
    integer(i8) function field_bytes(path, field) result(bytes)
       character(len=*), intent(in) :: path, field
+      character(len=:), allocatable :: value
+      integer(i8) :: kib
+      integer :: ios
+      bytes = -1
+      if (.not. line_after(path, field, value)) return
+      read (value, *, iostat=ios) kib
+      if (ios == 0) bytes = 1024_i8 * kib
+   end function field_bytes
+
+   !> The rest of the first line of file `path` that starts with `field`; false if the file cannot be
+   !> read or has no such line.
+   logical function line_after(path, field, value) result(found)
+      character(len=*), intent(in) :: path, field
+      character(len=:), allocatable, intent(out) :: value
       integer :: unit, ios
       character(len=256) :: line
-      integer(i8) :: kib
-      bytes = -1
+      found = .false.
+      value = ''
       open (newunit=unit, file=path, action='read', status='old', iostat=ios)
       if (ios /= 0) return
       do
          read (unit, '(a)', iostat=ios) line
          if (ios /= 0) exit
          if (line(1:len(field)) == field) then
-            read (line(len(field) + 1:), *, iostat=ios) kib
-            if (ios == 0) bytes = 1024_i8 * kib
+            value = trim(line(len(field) + 1:))
+            found = .true.
             exit
          end if
       end do
       close (unit)
-   end function field_bytes
+   end function line_after
 
    !> The number a file holds on its first line (as cgroup files do); -1 if it holds none ('max').
    integer(i8) function file_number(path) result(number)
@@ -107,29 +121,17 @@ contains
    !> `limits`, default /proc/self/limits) minus its VmSize; -1 when unlimited [bytes].
    integer(i8) function address_space_room_bytes(limits) result(bytes)
       character(len=*), intent(in), optional :: limits
-      character(len=*), parameter :: field = 'Max address space'
-      character(len=:), allocatable :: path
-      character(len=256) :: line
+      character(len=:), allocatable :: path, value
       character(len=32) :: soft
-      integer :: unit, ios
+      integer :: ios
       integer(i8) :: limit
       path = '/proc/self/limits'
       if (present(limits)) path = limits
       bytes = -1
-      open (newunit=unit, file=path, action='read', status='old', iostat=ios)
-      if (ios /= 0) return
-      do
-         read (unit, '(a)', iostat=ios) line
-         if (ios /= 0) exit
-         if (line(1:len(field)) == field) then
-            read (line(len(field) + 1:), *, iostat=ios) soft
-            if (ios == 0 .and. soft /= 'unlimited') then
-               read (soft, *, iostat=ios) limit
-               if (ios == 0 .and. limit < no_limit) bytes = max(0_i8, limit - virtual_bytes())
-            end if
-            exit
-         end if
-      end do
-      close (unit)
+      if (.not. line_after(path, 'Max address space', value)) return
+      read (value, *, iostat=ios) soft
+      if (ios /= 0 .or. soft == 'unlimited') return
+      read (soft, *, iostat=ios) limit
+      if (ios == 0 .and. limit < no_limit) bytes = max(0_i8, limit - virtual_bytes())
    end function address_space_room_bytes
 end module process_memory

@@ -35,7 +35,7 @@ module checkpoint
    use file_system, only: rename_path, remove_file, path_exists
    use status_broadcast, only: agree_on_status, broadcast_status
    use input_text, only: int_text
-   use scene_record, only: namelist_text_t, scene_namelist_groups, scene_namelist_text
+   use scene_record, only: scene_namelist_text
    use scene_comparison, only: scene_change_t, compare_scene_texts, describe_changes
    use provenance, only: write_provenance_attributes, agreed_date
    implicit none
@@ -45,12 +45,12 @@ module checkpoint
    character(len=*), parameter, public :: checkpoint_format = 'flotsam checkpoint'
    !> 2: grid rotation; 3: cuts sized (ranks + 1) x 3 for any rank grid (load balancing); their ends, the
    !> active box, need not be the grid's (a version-3 file of the whole grid is read the same way);
-   !> 4: the state of the load series; 5: the resolved scene (scene_group_<k>)
+   !> 4: the state of the load series; 5: the resolved scene (root attribute `scene`)
    integer, parameter, public :: checkpoint_format_version = 5
    !> The previous version: the same layout without the scene, read only with --allow-scene-change.
    integer, parameter :: unscened_format_version = 4
-   !> Longest text of one group of the stored scene read back.
-   integer, parameter :: group_text_len = 16384
+   !> Longest stored scene read back: an HDF5 attribute in the default (compact) storage holds at most 64 KiB.
+   integer, parameter :: scene_text_len = 65536
 
    !> What a checkpoint holds for this rank, read in full before any of it is adopted.
    type :: saved_state_t
@@ -105,8 +105,7 @@ contains
       call file%write_attribute('dt', solver%dt, status)
       call file%write_attribute('mass_tolerance', solver%mass_tolerance, status)
       call file%write_attribute('next_output_time', progress%next_output_time, status)
-      call write_scene_text(solver%scene, file, status)
-      ! program, date and resolved scene (its `ranks` is above)
+      ! program, date and the resolved scene a restart compares with (its `ranks` is above)
       call write_provenance_attributes(file, solver%scene, agreed_date(solver%domain%comm), status)
       call write_particles(solver, file, status)
       call write_series_state(solver, file, status)      ! after write_particles: it made the group ranks
@@ -476,37 +475,16 @@ contains
       end if
    end subroutine check_scene_changes
 
-   !> The resolved scene (scene_record) as attributes scene_groups = n and scene_group_1 ... _n, one
-   !> namelist group each (an attribute is limited to 64 KiB; a group stays far below).
-   subroutine write_scene_text(scene, file, status)
-      type(scene_t), intent(in) :: scene
-      type(hdf5_file_t), intent(inout) :: file
-      type(status_t), intent(inout) :: status
-      type(namelist_text_t), allocatable :: groups(:)
-      integer :: g
-      groups = scene_namelist_groups(scene)
-      call file%write_attribute('scene_groups', size(groups), status)
-      do g = 1, size(groups)
-         call file%write_attribute('scene_group_'//int_text(g), groups(g)%text, status)
-      end do
-   end subroutine write_scene_text
-
-   !> The scene text write_scene_text stored, groups on lines of their own.
+   !> The resolved scene the checkpoint's run used: its root attribute `scene` (provenance, written by
+   !> scene_record's scene_namelist_text).
    subroutine read_scene_text(file, text, status)
       type(hdf5_file_t), intent(in) :: file
       character(len=:), allocatable, intent(out) :: text
       type(status_t), intent(inout) :: status
-      character(len=group_text_len) :: group
-      integer :: n, g
-      text = ''
-      n = 0
-      call file%read_attribute('scene_groups', n, status)
-      do g = 1, n
-         group = ''
-         call file%read_attribute('scene_group_'//int_text(g), group, status)
-         if (.not. status%ok) return
-         text = text//trim(group)//new_line('a')
-      end do
+      character(len=scene_text_len) :: stored
+      stored = ''
+      call file%read_attribute('scene', stored, status)
+      text = trim(stored)
    end subroutine read_scene_text
 
    !> What the series of loads.csv, gauges.csv and bodies.csv carry from row to row (load_records): the

@@ -118,9 +118,7 @@ def check_scene_changes(flotsam, checks, template, reference_text):
     shutil.copytree(flotsam.path("reference"), flotsam.path("format_4"))
     checkpoint = sorted(os.listdir(flotsam.path("format_4", "checkpoints")))[-4]
     with h5py.File(flotsam.path("format_4", "checkpoints", checkpoint), "r+") as f:
-        for k in range(1, int(f.attrs["scene_groups"]) + 1):
-            del f.attrs[f"scene_group_{k}"]
-        del f.attrs["scene_groups"]
+        del f.attrs["scene"]
         f.attrs.modify("format_version", 4)
     old = flotsam.scene(template, "format_4.nml", "format_4")
     result = flotsam.run(old, RANKS, "--restart", os.path.join("format_4", "checkpoints", checkpoint))

@@ -16,9 +16,8 @@ import signal
 import stat
 import subprocess
 import sys
-import time
 
-from flotsam_run import MPI_ENVIRONMENT, Checks, main_arguments, read_diagnostics
+from flotsam_run import MPI_ENVIRONMENT, Checks, main_arguments, read_diagnostics, wait_for_rows
 
 FAKE_SRUN = """#!/bin/bash
 # srun stand-in: drop srun's options, start the tasks with the MPI launcher (exec: same pid, so a
@@ -42,19 +41,6 @@ def executable(path, text):
     with open(path, "w") as f:
         f.write(text)
     os.chmod(path, os.stat(path).st_mode | stat.S_IXUSR | stat.S_IXGRP | stat.S_IXOTH)
-
-
-def wait_for_rows(path, process, rows=1, timeout=300):
-    """Wait until diagnostics.csv `path` has `rows` rows after the initial one: the time loop runs, and
-    flotsam's signal handlers are installed (after the initial output). False if the run ended first."""
-    start = time.time()
-    while time.time() - start < timeout and process.poll() is None:
-        if os.path.exists(path):
-            with open(path) as f:
-                if sum(1 for line in f if line.strip() and not line.startswith("#")) >= rows + 2:
-                    return True
-        time.sleep(0.05)
-    return False
 
 
 def main():

@@ -19,10 +19,8 @@ import shutil
 import signal
 import subprocess
 import sys
-import time
 
-from flotsam_run import Checks, child_pids, main_arguments, read_diagnostics
-
+from flotsam_run import Checks, child_pids, main_arguments, read_diagnostics, wait_for_rows
 
 
 def ended(line):
@@ -50,19 +48,6 @@ def ranks_of(process, flotsam):
         except OSError:
             pass
     return ranks
-
-
-def wait_for_rows(path, process, rows=1, timeout=300):
-    """Wait until diagnostics.csv `path` has `rows` rows after the initial one: the time loop runs, and
-    flotsam's signal handlers are installed (after the initial output). False if the run ended first."""
-    start = time.time()
-    while time.time() - start < timeout and process.poll() is None:
-        if os.path.exists(path):
-            with open(path) as f:
-                if sum(1 for line in f if line.strip() and not line.startswith("#")) >= rows + 2:
-                    return True
-        time.sleep(0.05)
-    return False
 
 
 def read_results(path):

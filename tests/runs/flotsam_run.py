@@ -121,6 +121,19 @@ def wait_for_file(path, process, timeout=120):
     return False
 
 
+def wait_for_rows(path, process, rows=1, timeout=300):
+    """Wait until diagnostics.csv `path` has `rows` rows after the initial one: the time loop runs, and
+    flotsam's signal handlers are installed (after the initial output). False if the run ended first."""
+    start = time.time()
+    while time.time() - start < timeout and process.poll() is None:
+        if os.path.exists(path):
+            with open(path) as f:
+                if sum(1 for line in f if line.strip() and not line.startswith("#")) >= rows + 2:
+                    return True
+        time.sleep(0.05)
+    return False
+
+
 def rank_pids(pid):
     """The ranks started by the launcher `pid`: its descendants that have no children of their own
     (Open MPI's mpirun starts local ranks itself; MPICH's mpiexec through hydra_pmi_proxy)."""
@@ -210,5 +223,5 @@ def main_arguments():
     return sys.argv[1], sys.argv[2], os.path.abspath(sys.argv[3]), sys.argv[4:]
 
 
-__all__ = ["Checks", "Flotsam", "PrivateDisplay", "child_pids", "rank_pids", "wait_for_file", "signal_ranks",
-           "read_diagnostics", "csv_data_lines", "signal", "main_arguments"]
+__all__ = ["Checks", "Flotsam", "PrivateDisplay", "child_pids", "rank_pids", "wait_for_file", "wait_for_rows",
+           "signal_ranks", "read_diagnostics", "csv_data_lines", "signal", "main_arguments"]
