@@ -1,4 +1,4 @@
-!> Signed distances of the structure shapes (src/boundaries/signed_distance.f90) against distances
+!> Signed distances of the structure shapes (src/geometry/signed_distance.f90) against distances
 !> known by construction (points placed at a chosen distance from a face, an edge or a corner) and
 !> against independent computations: a square polygon and a square box must agree everywhere, and a
 !> triangle's distance is checked against a brute-force search over its edges and a barycentric inside test.
