@@ -16,7 +16,8 @@ module background_grid
    implicit none
    private
 
-   !> Rows of `accumulated`: mass, then momentum (dim), then force (dim).
+   !> Rows of `accumulated`: mass, then momentum (dim), then force (dim) of all particles; then, with contact
+   !> (src/solver/body_contact.f90), `field_rows` rows of the bodies' own velocity fields.
    integer, parameter, public :: row_mass = 1
 
    type, public :: grid_t
@@ -33,6 +34,7 @@ module background_grid
       !> along axis k the rank's cells end where the active region does: it owns its upper node layer too
       logical :: owns_upper(3) = .true.
       integer :: row_momentum = 2, row_force = 4, n_rows = 5
+      integer :: field_rows = 0                    !< rows of the contact fields after the force (kept by init)
       real(rp), allocatable :: accumulated(:, :)   !< (n_rows, node): mass, momentum, force
       real(rp), allocatable :: velocity(:, :)      !< v_i^{n+theta} used for kinematics and positions
       real(rp), allocatable :: velocity_increment(:, :)  !< dv_i = v_i^{n+1} - v_i^n (FLIP increment)
@@ -93,7 +95,7 @@ contains
 
       self%row_momentum = row_mass + 1
       self%row_force = self%row_momentum + self%dim
-      self%n_rows = 1 + 2 * self%dim
+      self%n_rows = 1 + 2 * self%dim + self%field_rows
       if (allocated(self%accumulated)) deallocate (self%accumulated, self%velocity, self%velocity_increment)
       allocate (self%accumulated(self%n_rows, self%node_count), self%velocity(self%dim, self%node_count), &
                 self%velocity_increment(self%dim, self%node_count), stat=stat)

@@ -154,6 +154,14 @@ module scene_description
       real(rp) :: radius = 0.0_rp
    end type gauge_spec_t
 
+   !> `&contact`: bodies of two solid materials (or of one, against each other) in contact with their own
+   !> velocity fields, separating and sliding with Coulomb friction (docs/contact.md).
+   type, public :: contact_spec_t
+      character(len=name_len) :: between(2) = ''   !< the two material names (may be the same)
+      real(rp) :: friction = 0.0_rp                !< Coulomb coefficient mu >= 0
+      integer :: material_index(2) = 0             !< derived: positions in scene%materials
+   end type contact_spec_t
+
    !> A whole scene.
    type, public :: scene_t
       character(len=path_len) :: source_file = ''
@@ -165,6 +173,7 @@ module scene_description
       type(wall_spec_t), allocatable :: walls(:)      !< `&wall` groups (the `&box_walls` sides are in grid)
       type(inlet_spec_t), allocatable :: inlets(:)
       type(gauge_spec_t), allocatable :: gauges(:)
+      type(contact_spec_t), allocatable :: contacts(:)
    end type scene_t
 
 contains

@@ -11,7 +11,7 @@ module scene_reader
    use kinds, only: rp, i8, path_len
    use error_status, only: status_t
    use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
-                                inlet_spec_t, gauge_spec_t, model_newtonian_fluid, model_linear_elastic
+                                inlet_spec_t, gauge_spec_t, contact_spec_t, model_newtonian_fluid, model_linear_elastic
    use namelist_scan, only: namelist_file_t, namelist_group_t, scan_namelist_file
    use scene_validation, only: validate_scene, resolve_scene, check_scene_memory, default_name, stabilization_keywords, &
                                oscillation_rule_keywords
@@ -39,12 +39,13 @@ module scene_reader
 
    !> The namelist groups of a scene file, in the order a resolved scene is written (scene_record).
    character(len=*), parameter, public :: known_groups(*) = &
-      [character(len=9) :: 'run', 'grid', 'box_walls', 'gravity', 'material', 'body', 'wall', 'inlet', 'gauge']
+      [character(len=9) :: 'run', 'grid', 'box_walls', 'gravity', 'material', 'body', 'wall', 'inlet', 'gauge', &
+                           'contact']
    !> Groups that may appear at most once.
    character(len=*), parameter :: singleton_groups(*) = [character(len=9) :: 'run', 'grid', 'box_walls', 'gravity']
    !> Groups that may appear any number of times, one scene entry each.
    character(len=*), parameter, public :: repeated_groups(*) = &
-      [character(len=8) :: 'material', 'body', 'wall', 'inlet', 'gauge']
+      [character(len=8) :: 'material', 'body', 'wall', 'inlet', 'gauge', 'contact']
    !> Groups a scene file must contain.
    character(len=*), parameter :: required_groups(*) = [character(len=8) :: 'run', 'grid', 'material']
 
@@ -52,7 +53,7 @@ module scene_reader
    type :: variable_info_t
       character(len=9) :: group
       character(len=26) :: name
-      character(len=7) :: kind          !< real, real3, integer, logical or string
+      character(len=7) :: kind          !< real, real3, integer, logical, string or string2 (two strings)
       logical :: required
    end type variable_info_t
 
@@ -143,7 +144,9 @@ module scene_reader
       variable_info_t('gauge', 'name', 'string', .true.), &
       variable_info_t('gauge', 'kind', 'string', .true.), &
       variable_info_t('gauge', 'point', 'real3', .true.), &
-      variable_info_t('gauge', 'radius', 'real', .false.)]
+      variable_info_t('gauge', 'radius', 'real', .false.), &
+      variable_info_t('contact', 'between', 'string2', .true.), &
+      variable_info_t('contact', 'friction', 'real', .false.)]
 
    !> Namelist buffers of string values are longer than the scene's fields, so that a value too long
    !> for its field is reported instead of cut.
@@ -283,7 +286,7 @@ contains
       if (.not. status%ok) return
       call read_singleton_groups(file, scene, status)
       if (.not. status%ok) return
-      allocate (probe%materials(1), probe%bodies(1), probe%walls(1), probe%inlets(1), probe%gauges(1))
+      allocate (probe%materials(1), probe%bodies(1), probe%walls(1), probe%inlets(1), probe%gauges(1), probe%contacts(1))
       do g = 1, size(file%groups)
          group = file%groups(g)%name
          if (.not. any(repeated_groups == group)) cycle
@@ -381,6 +384,8 @@ contains
          if (allocated(scene%inlets)) n = size(scene%inlets)
       case ('gauge')
          if (allocated(scene%gauges)) n = size(scene%gauges)
+      case ('contact')
+         if (allocated(scene%contacts)) n = size(scene%contacts)
       end select
    end function entry_count
 
@@ -496,13 +501,15 @@ contains
       type(wall_spec_t) :: default_wall
       type(inlet_spec_t) :: default_inlet
       type(gauge_spec_t) :: default_gauge
+      type(contact_spec_t) :: default_contact
       character(len=512) :: message
       character(len=:), allocatable :: group
       integer :: g, k, ios
 
       allocate (scene%materials(file%count('material')), scene%bodies(file%count('body')), &
-                scene%walls(file%count('wall')), scene%inlets(file%count('inlet')), scene%gauges(file%count('gauge')))
-      allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1), one%gauges(1))
+                scene%walls(file%count('wall')), scene%inlets(file%count('inlet')), scene%gauges(file%count('gauge')), &
+                scene%contacts(file%count('contact')))
+      allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1), one%gauges(1), one%contacts(1))
       do g = 1, size(repeated_groups)
          group = trim(repeated_groups(g))
          do k = 1, file%count(group)
@@ -511,6 +518,7 @@ contains
             one%walls(1) = default_wall
             one%inlets(1) = default_inlet
             one%gauges(1) = default_gauge
+            one%contacts(1) = default_contact
             message = ''
             call read_group(group, one, 1, ios, message, file%groups(file%find(group, k))%text())
             if (ios /= 0) then
@@ -528,6 +536,8 @@ contains
                scene%inlets(k) = one%inlets(1)
             case ('gauge')
                scene%gauges(k) = one%gauges(1)
+            case ('contact')
+               scene%contacts(k) = one%contacts(1)
             end select
          end do
       end do
@@ -555,6 +565,8 @@ contains
             where = group_context(file%path, group, k, material_detail(scene%inlets(k)%material))
          case ('gauge')
             where = group_context(file%path, group, k, name_detail(scene%gauges(k)%name))
+         case ('contact')
+            where = group_context(file%path, group, k)
          case default
             where = group_context(file%path, group, 0)
          end select
@@ -625,7 +637,7 @@ contains
          call status%fail(file%path//': group &'//group//label//': '//trim(message))
          return
       end if
-      allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1), one%gauges(1))
+      allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1), one%gauges(1), one%contacts(1))
       associate (items => file%groups(g)%items)
          do i = 1, size(items)
             prefix = file%path//': line '//int_text(items(i)%line)//': group &'//group//label
@@ -708,6 +720,8 @@ contains
          text = 'an integer (no decimal point or exponent)'
       case ('logical')
          text = 'a logical (.true. or .false.)'
+      case ('string2')
+         text = "two quoted strings ('a', 'b')"
       case default
          text = 'a quoted string'
       end select
@@ -745,6 +759,8 @@ contains
          call read_inlet_group(scene%inlets(k), ios, message, text)
       case ('gauge')
          call read_gauge_group(scene%gauges(k), ios, message, text)
+      case ('contact')
+         call read_contact_group(scene%contacts(k), ios, message, text)
       case default
          ios = value_too_long
          message = 'no namelist group &'//group
@@ -1104,4 +1120,22 @@ contains
       spec%point = point
       spec%radius = radius
    end subroutine read_gauge_group
+
+   subroutine read_contact_group(spec, ios, message, text)
+      type(contact_spec_t), intent(inout) :: spec
+      integer, intent(out) :: ios
+      character(len=*), intent(inout) :: message
+      character(len=*), intent(in) :: text
+      character(len=text_len) :: between(2)
+      real(rp) :: friction
+      namelist /contact/ between, friction
+
+      between = spec%between
+      friction = spec%friction
+      read (text, nml=contact, iostat=ios, iomsg=message)
+      call take_text('between', between(1), spec%between(1), ios, message)
+      call take_text('between', between(2), spec%between(2), ios, message)
+      if (ios /= 0) return
+      spec%friction = friction
+   end subroutine read_contact_group
 end module scene_reader

@@ -103,6 +103,8 @@ contains
          text = inlet_value(scene, k, name)
       case ('gauge')
          text = gauge_value(scene, k, name)
+      case ('contact')
+         text = contact_value(scene, k, name)
       case default
          text = ''
       end select
@@ -362,6 +364,23 @@ contains
          end select
       end associate
    end function gauge_value
+
+   function contact_value(scene, k, name) result(text)
+      type(scene_t), intent(in) :: scene
+      integer, intent(in) :: k
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: text
+      associate (contact => scene%contacts(k))
+         select case (name)
+         case ('between')
+            text = quoted(contact%between(1))//', '//quoted(contact%between(2))
+         case ('friction')
+            text = real_text(contact%friction)
+         case default
+            text = ''
+         end select
+      end associate
+   end function contact_value
 
    !> 'text' with an apostrophe doubled, trailing blanks removed.
    pure function quoted(value) result(text)

@@ -7,7 +7,7 @@ module scene_validation
    use kinds, only: rp, i8, name_len
    use error_status, only: status_t
    use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
-                                inlet_spec_t, gauge_spec_t, opening_far_end, wall_none, wall_slip, wall_no_slip, &
+                                inlet_spec_t, gauge_spec_t, contact_spec_t, opening_far_end, wall_none, wall_slip, wall_no_slip, &
                                 model_newtonian_fluid, model_linear_elastic, gauge_pressure, gauge_level, gauge_velocity, &
                                 particle_field_names, field_precision_keywords
    use input_text, only: int_text, real_text, quoted_list, group_context, ordinal
@@ -125,6 +125,13 @@ contains
          end do
       end if
       call validate_load_names(scene, path, status)
+      if (.not. status%ok) return
+      if (allocated(scene%contacts)) then
+         do i = 1, size(scene%contacts)
+            call validate_contact(scene%contacts, i, scene%materials, path, status)
+            if (.not. status%ok) return
+         end do
+      end if
    end subroutine validate_scene
 
    !> Particles body b (b > 0) or inlet -b (b < 0) of the scene creates over the run (a real: a bad
@@ -309,6 +316,12 @@ contains
             inlet%direction(1:scene%grid%dim) = inlet%direction(1:scene%grid%dim) / norm2(inlet%direction(1:scene%grid%dim))
             if (len_trim(inlet%name) == 0) inlet%name = default_name('inlet', i)
          end associate
+      end do
+      if (.not. allocated(scene%contacts)) allocate (scene%contacts(0))
+      do i = 1, size(scene%contacts)
+         do k = 1, 2
+            scene%contacts(i)%material_index(k) = find_material(scene%materials, scene%contacts(i)%between(k))
+         end do
       end do
       if (.not. allocated(scene%gauges)) allocate (scene%gauges(0))
       do g = 1, size(scene%gauges)
@@ -854,6 +867,64 @@ contains
          end do
       end associate
    end subroutine validate_gauge
+
+   !> `&contact`: two declared solid materials (fluid-solid contact is not implemented: a fluid shares the
+   !> common velocity field, docs/contact.md), a pair no earlier &contact gives (in either order), mu >= 0.
+   subroutine validate_contact(contacts, c, materials, path, status)
+      type(contact_spec_t), intent(in) :: contacts(:)
+      integer, intent(in) :: c
+      type(material_spec_t), intent(in) :: materials(:)
+      character(len=*), intent(in) :: path
+      type(status_t), intent(inout) :: status
+      character(len=:), allocatable :: where
+      character(len=name_len) :: declared(size(materials))
+      integer :: k, m, other
+
+      associate (contact => contacts(c))
+         where = group_context(path, 'contact', c)
+         if (any(len_trim(contact%between) == 0)) then
+            call status%fail(where//": variable between must name two materials ('a', 'b'; the same name twice for "// &
+                             "bodies of one material), got "//pair_text(contact%between))
+            return
+         end if
+         where = group_context(path, 'contact', c, 'between '//pair_text(contact%between))
+         do k = 1, 2
+            m = find_material(materials, contact%between(k))
+            if (m == 0) then
+               do m = 1, size(materials)
+                  declared(m) = materials(m)%name
+               end do
+               call status%fail(where//': variable between must name declared &material groups ('// &
+                                quoted_list(declared)//"), got '"//trim(contact%between(k))//"'")
+               return
+            end if
+            if (materials(m)%model == model_newtonian_fluid) then
+               call status%fail(where//": variable between names the fluid '"//trim(contact%between(k))// &
+                                "': contact of a fluid is not implemented (fluids share the common velocity "// &
+                                'field with the solids, docs/contact.md); name solid materials only')
+               return
+            end if
+         end do
+         do other = 1, c - 1
+            if ((contacts(other)%between(1) == contact%between(1) .and. &
+                 contacts(other)%between(2) == contact%between(2)) .or. &
+                (contacts(other)%between(1) == contact%between(2) .and. &
+                 contacts(other)%between(2) == contact%between(1))) then
+               call status%fail(where//': variable between names the same pair as the '//ordinal(other)// &
+                                ' &contact; give each pair once')
+               return
+            end if
+         end do
+         call check_real(where, 'friction', contact%friction, status, at_least=0.0_rp)
+      end associate
+   end subroutine validate_contact
+
+   !> "'steel', 'wood'" for messages.
+   pure function pair_text(names) result(text)
+      character(len=*), intent(in) :: names(2)
+      character(len=:), allocatable :: text
+      text = "'"//trim(names(1))//"', '"//trim(names(2))//"'"
+   end function pair_text
 
    !> The names of the walls (box sides that are walls, &wall), inlets and bodies are one namespace: the
    !> columns of loads.csv and bodies.csv, and the labels of their plots. A name the scene gives must

@@ -2,7 +2,8 @@
 !>
 !> One step t_n -> t_n+1:
 !>   1. particles -> grid (mass, momentum, internal and external force), ghost-node sums
-!>   2. nodal update v^{n+1} = v^n + dt f / m, wall constraints (eq. 14), dv and v^{n+theta}
+!>   2. nodal update v^{n+1} = v^n + dt f / m, wall constraints (eq. 14), dv and v^{n+theta}; with &contact
+!>      per velocity field, the bodies' fields meeting at a node by contact (body_contact)
 !>   3. stabilization schemes bin their cells at x^n
 !>   4. grid -> particles: L_p, FLIP/PIC velocity, positions (MUSL: re-map before L)
 !>   5. filter part A (d -> d~), constitutive update per material, filter part B (sbar -> sbar~)
@@ -36,6 +37,7 @@ module mpm_solver
    use wall_loads, only: wall_loads_t
    use fluid_gauges, only: fluid_gauges_t
    use body_motion, only: body_motion_t
+   use body_contact, only: contact_t, contact_field_rows
    use world_frame, only: frame_t, place_grid
    use grid_transfer, only: particles_to_grid, update_velocity_and_remap, grid_to_particles
    use run_diagnostics, only: diagnostics_t, compute_diagnostics
@@ -68,6 +70,7 @@ module mpm_solver
       type(wall_loads_t) :: loads               !< impulse of every wall since the last row of loads.csv
       type(fluid_gauges_t) :: gauges            !< the &gauge sensors (gauges.csv)
       type(body_motion_t) :: bodies             !< the solid bodies (bodies.csv)
+      type(contact_t) :: contact                !< velocity fields of the bodies in contact (&contact)
       real(rp) :: time = 0.0_rp, dt = 0.0_rp
       integer(i8) :: step = 0
       integer :: lost_particles = 0             !< local count of particles that left the grid
@@ -124,6 +127,7 @@ contains
       call target_box(need_lo, need_hi, guard_cells(1.0_rp) + slack_cells, grid_cells, dim, box_lo, box_hi)
       call self%domain%init(comm, dim, grid_cells, status, box_lo, box_hi)
       if (.not. status%ok) return
+      self%grid%field_rows = contact_field_rows(scene)
       call self%grid%init(self%domain, grid_origin, scene%grid%cell_size, frame, status)
       call build_materials(scene%materials, self%materials, status)
       if (status%ok) call build_stabilizers(scene%materials, self%schemes, status)
@@ -134,6 +138,7 @@ contains
       call self%loads%init(scene)
       call self%gauges%init(scene, frame, self%gravity)
       call self%bodies%init(scene, self%materials, frame, self%gravity)
+      call self%contact%init(scene, self%bodies, size(self%materials))
 
       call self%particles%init(scene%grid%dim, size(scene%materials), 1024)
       seed = .true.
@@ -189,6 +194,7 @@ contains
       type(solver_t), intent(inout) :: self
       if (allocated(self%remapped_momentum)) deallocate (self%remapped_momentum)
       if (self%musl) allocate (self%remapped_momentum(self%grid%dim, self%grid%node_count))
+      if (self%contact%active) call self%contact%size_nodes(self%grid, self%musl)
    end subroutine size_node_arrays
 
    !> Rebalance if the largest rank holds more than rebalance_threshold times the mean number of
@@ -313,7 +319,13 @@ contains
             spin_needed = .true.
       end do
       call self%timers%switch_to(phase_particles_to_grid)
-      call particles_to_grid(self%grid, self%particles, self%gravity)
+      if (self%contact%active) then
+         call self%contact%assign_fields(self%particles)
+         call particles_to_grid(self%grid, self%particles, self%gravity, self%contact%particle_field, &
+                                self%contact%field_row)
+      else
+         call particles_to_grid(self%grid, self%particles, self%gravity)
+      end if
       call self%timers%switch_to(phase_halo)
       call sum_shared_nodes(self%domain, self%grid, self%grid%accumulated)
       call self%timers%switch_to(phase_grid_update)
@@ -327,8 +339,19 @@ contains
       end do
 
       call self%timers%switch_to(phase_grid_to_particles)
-      associate (run => self%run)
-         if (self%musl) then
+      associate (run => self%run, contact => self%contact)
+         if (contact%active .and. self%musl) then
+            call remap_velocities(self)
+            call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
+                                   update_velocity=.false., compute_strain=.true., update_position=.true., &
+                                   strain_velocity=contact%remapped, compute_spin=spin_needed, extent=self%extent, &
+                                   field=contact%particle_field, velocity=contact%velocity, increment=contact%increment)
+         else if (contact%active) then
+            call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
+                                   update_velocity=.true., compute_strain=.true., update_position=.true., &
+                                   compute_spin=spin_needed, extent=self%extent, field=contact%particle_field, &
+                                   velocity=contact%velocity, increment=contact%increment)
+         else if (self%musl) then
             call remap_velocities(self)
             call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
                                    update_velocity=.false., compute_strain=.true., update_position=.true., &
@@ -424,12 +447,20 @@ contains
    end function material_supplied
 
    !> Step 2: v^n = P/m, v^{n+1} = v^n + dt f/m, walls, dv = v^{n+1} - v^n (contains the wall correction).
+   !> With contact, the same per velocity field and the contact between them (body_contact).
    subroutine update_nodes(self, dt)
       type(solver_t), intent(inout) :: self
       real(rp), intent(in) :: dt
       integer :: i, dim, mom, frc
       real(rp) :: m
       dim = self%grid%dim
+      if (self%contact%active) then
+         call self%contact%nodal_velocities(self%grid, dt, self%mass_tolerance)
+         call self%timers%switch_to(phase_walls)
+         call self%contact%apply_walls(self%walls, self%grid, self%loads%step_impulse)
+         call self%timers%switch_to(phase_grid_update)
+         return
+      end if
       mom = self%grid%row_momentum
       frc = self%grid%row_force
       associate (acc => self%grid%accumulated, v => self%grid%velocity, dv => self%grid%velocity_increment)
@@ -457,6 +488,16 @@ contains
       type(solver_t), intent(inout) :: self
       integer :: i
       real(rp) :: m
+      if (self%contact%active) then
+         call update_velocity_and_remap(self%grid, self%particles, self%run%flip_fraction, self%contact%remapped, &
+                                        self%contact%particle_field, self%contact%velocity, self%contact%increment)
+         call self%timers%switch_to(phase_halo)
+         call sum_shared_nodes(self%domain, self%grid, self%contact%remapped)
+         call self%timers%switch_to(phase_grid_to_particles)
+         call self%contact%remapped_velocities(self%walls, self%grid, self%mass_tolerance)
+         call self%timers%switch_to(phase_grid_to_particles)
+         return
+      end if
       call update_velocity_and_remap(self%grid, self%particles, self%run%flip_fraction, self%remapped_momentum)
       call self%timers%switch_to(phase_halo)
       call sum_shared_nodes(self%domain, self%grid, self%remapped_momentum)

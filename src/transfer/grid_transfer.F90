@@ -16,12 +16,22 @@ contains
 
    !> Step 1: m_i = sum N m_p, P_i = sum N m_p v_p,
    !> f_i = -sum m_p sbar_p . grad N_i + sum N m_p g   ([Y17] eq. 3; sbar is the filtered stress).
-   subroutine particles_to_grid(grid, particles, gravity)
+   !> With `field` (contact, src/solver/body_contact.f90): also each body field's mass, momentum, force and
+   !> mass gradient sum m_p grad N_i in its rows of grid%accumulated from `field_row` on (field(p) = 0: the
+   !> common field, only in the totals).
+   subroutine particles_to_grid(grid, particles, gravity, field, field_row)
       type(grid_t), intent(inout) :: grid
       type(particle_set_t), intent(in) :: particles
       real(rp), intent(in) :: gravity(:)
+      integer, intent(in), optional :: field(:), field_row
       grid%accumulated = 0.0_rp
-      if (grid%dim == 2) then
+      if (present(field)) then
+         if (grid%dim == 2) then
+            call particles_to_grid_fields_2d(grid, particles, gravity, field, field_row)
+         else
+            call particles_to_grid_fields_3d(grid, particles, gravity, field, field_row)
+         end if
+      else if (grid%dim == 2) then
          call particles_to_grid_2d(grid, particles, gravity)
       else
          call particles_to_grid_3d(grid, particles, gravity)
@@ -30,13 +40,23 @@ contains
 
    !> MUSL, first half of step 7 fused with the re-map: v_p := alpha (v_p + sum N dv_i) + (1 - alpha) sum N
    !> v_i^{n+1}, then momentum(:, i) = sum N m_p v_p with the updated velocities (both at x^n).
-   subroutine update_velocity_and_remap(grid, particles, flip_fraction, momentum)
+   !> With `field`: each particle's nodal velocities come from its field's rows of `velocity` and
+   !> `increment` (dim (fields + 1), node); momentum rows 1:dim get the total, rows f dim + 1.. field f's.
+   subroutine update_velocity_and_remap(grid, particles, flip_fraction, momentum, field, velocity, increment)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
       real(rp), intent(in) :: flip_fraction
       real(rp), intent(out) :: momentum(:, :)
+      integer, intent(in), optional :: field(:)
+      real(rp), intent(in), optional :: velocity(:, :), increment(:, :)
       momentum = 0.0_rp
-      if (grid%dim == 2) then
+      if (present(field)) then
+         if (grid%dim == 2) then
+            call momentum_to_grid_fields_2d(grid, particles, flip_fraction, momentum, field, velocity, increment)
+         else
+            call momentum_to_grid_fields_3d(grid, particles, flip_fraction, momentum, field, velocity, increment)
+         end if
+      else if (grid%dim == 2) then
          call momentum_to_grid_2d(grid, particles, flip_fraction, momentum)
       else
          call momentum_to_grid_3d(grid, particles, flip_fraction, momentum)
@@ -51,8 +71,10 @@ contains
    !> `compute_spin` (default: as compute_strain) = .false. leaves the spin alone: only solids use it.
    !> `extent` returns the lowest (:, 1) and highest (:, 2) new position along each axis (with
    !> update_position; 0 beyond dim): the active region's check needs it, and here it costs no pass.
+   !> With `field` (contact): particle p reads v, dv (and the strain velocity) of its field, rows
+   !> field(p) dim + 1.. of `velocity` and `increment` (dim (fields + 1), node), not the grid's.
    subroutine grid_to_particles(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
-                                update_position, strain_velocity, compute_spin, extent)
+                                update_position, strain_velocity, compute_spin, extent, field, velocity, increment)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
       real(rp), intent(in) :: dt, flip_fraction, theta
@@ -60,13 +82,24 @@ contains
       real(rp), intent(in), optional :: strain_velocity(:, :)
       logical, intent(in), optional :: compute_spin
       real(rp), intent(out), optional :: extent(3, 2)
+      integer, intent(in), optional :: field(:)
+      real(rp), intent(in), optional :: velocity(:, :), increment(:, :)
       real(rp) :: lo(3), hi(3)
       logical :: spin
       spin = compute_strain
       if (present(compute_spin)) spin = compute_strain .and. compute_spin
       lo = 0.0_rp
       hi = 0.0_rp
-      if (grid%dim == 2) then
+      if (present(field)) then
+         if (grid%dim == 2) then
+            call grid_to_particles_fields_2d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
+                                             spin, update_position, lo(1:2), hi(1:2), field, velocity, increment, &
+                                             strain_velocity)
+         else
+            call grid_to_particles_fields_3d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
+                                             spin, update_position, lo, hi, field, velocity, increment, strain_velocity)
+         end if
+      else if (grid%dim == 2) then
          call grid_to_particles_2d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
                                    spin, update_position, lo(1:2), hi(1:2), strain_velocity)
       else
@@ -107,6 +140,10 @@ contains
       end if
    end subroutine gradient_at_particles
 
+! Single-field kernels: nodal velocities from the grid
+#define VEL(i, node) grid%velocity(i, node)
+#define INC(i, node) grid%velocity_increment(i, node)
+
 #define KERNEL_DIM 2
 #define SHAPE shape_2d
 #define LOCATE locate_2d
@@ -135,5 +172,42 @@ contains
 #define V2G volume_to_grid_3d
 #define GRAD2P gradient_at_particles_3d
 #include "../grid/multilinear_shape.inc"
+#include "grid_transfer_kernels.inc"
+#undef KERNEL_DIM
+#undef SHAPE
+#undef LOCATE
+#undef P2G
+#undef M2G
+#undef G2P
+#undef V2G
+#undef GRAD2P
+#undef VEL
+#undef INC
+
+! Multi-field kernels of contact: each particle's own field, rows o + 1.. (o = field(p) dim)
+#define FIELDS
+#define VEL(i, node) velocity(o + (i), node)
+#define INC(i, node) increment(o + (i), node)
+
+#define KERNEL_DIM 2
+#define SHAPE shape_2d
+#define LOCATE locate_2d
+#define P2G particles_to_grid_fields_2d
+#define M2G momentum_to_grid_fields_2d
+#define G2P grid_to_particles_fields_2d
+#include "grid_transfer_kernels.inc"
+#undef KERNEL_DIM
+#undef SHAPE
+#undef LOCATE
+#undef P2G
+#undef M2G
+#undef G2P
+
+#define KERNEL_DIM 3
+#define SHAPE shape_3d
+#define LOCATE locate_3d
+#define P2G particles_to_grid_fields_3d
+#define M2G momentum_to_grid_fields_3d
+#define G2P grid_to_particles_fields_3d
 #include "grid_transfer_kernels.inc"
 end module grid_transfer
