@@ -480,6 +480,9 @@ contains
    !> The safeguard of a structure: a particle with phi < 0 moves to its foot point x - phi n on the
    !> surface (n = grad phi at x) and loses its normal velocity into the structure (friction: Coulomb's
    !> share of the tangential one too). Unlike a wall's, it acts at any depth: a structure is solid.
+   !> A particle put on a curved surface lands at phi = 0 only to round-off; counting it inside only below
+   !> -on_wall_tolerance h keeps the next step's decision (and its change of velocity) from depending on
+   !> that round-off, which differs with the number of ranks.
    subroutine keep_outside_structure(wall, grid, particles, corrections, impulse)
       type(wall_t), intent(in) :: wall
       type(grid_t), intent(in) :: grid
@@ -487,14 +490,15 @@ contains
       integer, intent(inout) :: corrections
       real(rp), intent(inout) :: impulse(:)
       integer :: p, d
-      real(rp) :: world(particles%dim), phi, n(particles%dim), before(particles%dim), step
+      real(rp) :: world(particles%dim), phi, n(particles%dim), before(particles%dim), step, tolerance
       d = particles%dim
       step = normal_step_in_cells * grid%h
+      tolerance = on_wall_tolerance * grid%h
       do p = 1, particles%count
          if (any(particles%x(:, p) < wall%box_lower(1:d)) .or. any(particles%x(:, p) > wall%box_upper(1:d))) cycle
          world = grid%frame%world_point(particles%x(:, p))
          phi = shape_distance(wall%shape, world)
-         if (phi >= 0.0_rp) cycle
+         if (phi >= -tolerance) cycle
          n = grid%frame%grid_vector(shape_normal(wall%shape, world, step))
          particles%x(:, p) = particles%x(:, p) - phi * n
          if (dot_product(particles%v(:, p), n) < 0.0_rp) then

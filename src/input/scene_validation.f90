@@ -334,10 +334,7 @@ contains
             if (len_trim(structure%name) == 0) structure%name = default_name('structure', i)
             ! a box given by its corners becomes centre and size (validated: both corners, no centre/size)
             if (structure%lower(1) < huge(1.0_rp)) then
-               associate (box => box_from_corners(structure%lower, structure%upper))
-                  structure%shape%centre(1:scene%grid%dim) = box%centre(1:scene%grid%dim)
-                  structure%shape%size(1:scene%grid%dim) = box%size(1:scene%grid%dim)
-               end associate
+               structure%shape = box_corners(structure%shape, structure%lower, structure%upper, scene%grid%dim)
                structure%lower = huge(1.0_rp)
                structure%upper = huge(1.0_rp)
             end if
@@ -892,10 +889,7 @@ contains
                                 real_text(structure%lower(k))//', got '//real_text(structure%upper(k)))
             if (.not. status%ok) return
          end do
-         associate (box => box_from_corners(structure%lower, structure%upper))
-            shape%centre(1:dim) = box%centre(1:dim)
-            shape%size(1:dim) = box%size(1:dim)
-         end associate
+         shape = box_corners(shape, structure%lower, structure%upper, dim)
       end if
 
       problem = shape_problem(shape, dim)
@@ -922,6 +916,23 @@ contains
          end if
       end do
    end subroutine validate_structure
+
+   !> `shape` with the centre and size of the box lower..upper (its first dim components; rotation kept).
+   pure function box_corners(shape, lower, upper, dim) result(box)
+      type(shape_t), intent(in) :: shape
+      real(rp), intent(in) :: lower(3), upper(3)
+      integer, intent(in) :: dim
+      type(shape_t) :: box, corners
+      real(rp) :: lo(3), up(3)
+      lo = 0.0_rp
+      up = 0.0_rp
+      lo(1:dim) = lower(1:dim)
+      up(1:dim) = upper(1:dim)
+      corners = box_from_corners(lo, up)
+      box = shape
+      box%centre(1:dim) = corners%centre(1:dim)
+      box%size(1:dim) = corners%size(1:dim)
+   end function box_corners
 
    !> The value that marks the end of a vertex list (a NaN is a value given, and reported as such).
    elemental logical function is_none(value)

@@ -19,7 +19,7 @@ module wall_loads
 
    type, public :: wall_loads_t
       integer :: dim = 2
-      character(len=name_len), allocatable :: names(:)   !< one entry per wall, box side and inlet
+      character(len=name_len), allocatable :: names(:)   !< one entry per wall, box side, inlet and structure
       real(rp), allocatable :: step_impulse(:, :)        !< (impulse_rows, wall) this rank, this step
       real(rp), allocatable :: impulse(:, :)             !< (impulse_rows, entry) this rank, since last row
       !> time of the last row of loads.csv, gauges.csv and bodies.csv: the start of the interval now
