@@ -189,13 +189,17 @@ contains
       end associate
    end function grid_value
 
-   !> `x_min` ... `z_max`: the side's condition; `x_min_name` ...: its name.
+   !> `x_min` ... `z_max`: the side's condition; `x_min_name` ...: its name; `friction`: the sides' mu.
    function box_walls_value(scene, name) result(text)
       type(scene_t), intent(in) :: scene
       character(len=*), intent(in) :: name
       character(len=:), allocatable :: text
       integer :: axis, side
       text = ''
+      if (name == 'friction') then
+         text = real_text(scene%grid%wall_friction)
+         return
+      end if
       if (len(name) < 5) return
       axis = index(axis_letters, name(1:1))
       side = 0
@@ -207,7 +211,6 @@ contains
       else if (name(6:) == '_name') then
          text = quoted(scene%grid%wall_name(side, axis))
       end if
-      if (name == 'friction') text = real_text(scene%grid%wall_friction)
    end function box_walls_value
 
    function material_value(scene, k, name) result(text)
