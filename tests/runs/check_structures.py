@@ -17,8 +17,8 @@ scenes are in tests/runs/scenes/structures/ (each explains its set-up and the ex
   5. restart: the same run stopped at max_steps and continued from a checkpoint writes loads.csv byte
      for byte as the uninterrupted run.
 With --long (label validation, structures_validation): the buoyancy of the circle and the turned box at
-h = 0.04, 0.02, 0.01 m and of a sphere in 3-D at h = 0.05, 0.04, 1/30 m, the error printed per
-resolution and asserted to shrink with h (first order, docs/loads.md).
+h = 0.04, 0.02, 0.01 m (within 3 % at each) and of a sphere in 3-D at h = 0.05, 0.04, 1/30 m (the error
+must shrink with h), the errors printed per resolution (docs/loads.md).
 
 usage: check_structures.py <flotsam> <mpiexec> <tests/runs/scenes> [<scripts folder>] [--long]"""
 
@@ -108,8 +108,12 @@ def check_buoyancy_convergence(checks, flotsam, scenes):
             print(f"     {scene}: h = {h:.4g} m (R/h = {size / h:.3g}): upward {mean[f'{structure}_{up}']:.6g} "
                   f"against {exact:.6g}, error {errors[-1]:+.2%}; sideways {sideways / exact:.1e}, "
                   f"moment {moment / (exact * size):.1e} of buoyancy x {size} m", flush=True)
-        checks.check(abs(errors[-1]) < abs(errors[0]) and abs(errors[-1]) <= 0.15,
-                     f"{scene}: the error shrinks with h: " + ", ".join(f"{e:+.2%}" for e in errors))
+        listed = ", ".join(f"{e:+.2%}" for e in errors)
+        if scene == "buoyancy_sphere":
+            # coarse in 3-D (R/h = 4 .. 6): a first-order error that must shrink with h
+            checks.check(abs(errors[2]) < abs(errors[1]) < abs(errors[0]), f"{scene}: the error shrinks with h: {listed}")
+        else:
+            checks.check(max(abs(e) for e in errors) <= 0.03, f"{scene}: within 3 % at every h: {listed}")
 
 
 # --- 2: the elastic bar -----------------------------------------------------------------------------------
@@ -184,7 +188,7 @@ def check_ranks(checks, flotsam, scenes):
         return None
     loads = read(runs[2], "loads")
     checks.check(loads["column_fx"].max() > 10.0,
-                 f"column_flow: the water and the debris reach the column (largest column_fx "
+                 f"column_flow: the flow reaches the column (largest column_fx "
                  f"{loads['column_fx'].max():.4g} N/m; ramp_fx {loads['ramp_fx'].abs().max():.4g} N/m)")
     for ranks in (1, 4):
         if ranks in runs:
