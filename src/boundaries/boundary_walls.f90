@@ -1,11 +1,19 @@
-!> Rigid walls: nodal velocity constraints and the particle safeguard (algorithms.md sections 4.1-4.2).
+!> Rigid walls and fixed structures: nodal velocity constraints and the particle safeguard
+!> (algorithms.md sections 4.1-4.2, docs/theory.md section 3.4).
 !>
-!> A wall is the part of a plane (point x_w, unit normal n_w pointing into the fluid) inside a world-frame
-!> box, its extent. Its signed distance is phi(x) = n_w . (x - x_w). The nodes it constrains are found
-!> once, by signed distance [R]: nodes with -depth <= phi <= 0 (on the wall or behind it, within two
-!> cells) whose foot point x - phi n_w lies in the extent widened by `margin` (h for walls, the cells cut
-!> by the wall's ends). On an aligned grid these are exactly the nodes on the wall's grid line.
+!> A constraint surface has a signed distance phi (negative behind it) and a unit normal n pointing
+!> into the material. Two kinds share every operation below:
+!>  - a planar wall: the part of a plane (point x_w, normal n_w) inside a world-frame box, its extent;
+!>    phi(x) = n_w . (x - x_w), one normal for all its nodes;
+!>  - a structure (`&structure`, `shaped`): the surface of a shape_t (shape_geometry), phi its exact
+!>    signed distance, n = grad phi, evaluated once per node when the node list is built.
+!> The nodes it constrains are found once per layout, by signed distance [R]: nodes with
+!> -depth <= phi <= 0 (on the surface or behind it, within two cells); for a planar wall also with the
+!> foot point x - phi n_w in the extent widened by `margin` (h for walls, the cells cut by the wall's
+!> ends). On an aligned grid these are exactly the nodes on the wall's grid line.
 !>   slip       [Y17] eq. 14, unilateral and frictionless: v := v - (v.n) n only where v.n < 0
+!>   friction   unilateral with Coulomb friction mu where v.n < 0: the normal part removed, the tangential
+!>              part shortened by mu |v.n| and never reversed (unilateral_velocity) [R]
 !>   no_slip    v := 0
 !>   prescribed v := v_0 (the feeder of an inlet, algorithms.md section 4.3)
 !> A wall may be active for a time window only (an inlet's opening and its closing wall).
@@ -17,19 +25,24 @@
 !> counted by one of them only (`counted`).
 module boundary_walls
    use kinds, only: rp
-   use scene_description, only: wall_spec_t, grid_spec_t, wall_none, wall_no_slip
+   use scene_description, only: wall_spec_t, grid_spec_t, structure_spec_t, wall_none, wall_no_slip, wall_friction
+   use shape_geometry, only: shape_t, shape_distance, shape_normal, shape_bounds
    use background_grid, only: grid_t
    use particle_set, only: particle_set_t
    implicit none
    private
 
-   integer, parameter, public :: wall_kind_slip = 1, wall_kind_no_slip = 2, wall_kind_prescribed = 3
+   integer, parameter, public :: wall_kind_slip = 1, wall_kind_no_slip = 2, wall_kind_prescribed = 3, &
+                                 wall_kind_friction = 4
    !> Nodes and particles farther behind a wall than this many cells are not its business [R]: a
    !> particle in a cell cut by the wall reaches nodes at most sqrt(dim) h behind it, and a baffle made of
    !> two walls back to back must not constrain the far side.
    real(rp), parameter :: depth_in_cells = 2.0_rp
    !> A node closer to the wall than this fraction of h counts as on it (round-off of node positions).
    real(rp), parameter :: on_wall_tolerance = 1.0e-9_rp
+   !> Step of the central differences of a shape's normal, in cells: far below the curvature of any
+   !> resolved surface, far above the round-off of the distance (1e-16 m / 1e-4 h).
+   real(rp), parameter :: normal_step_in_cells = 1.0e-4_rp
 
    type, public :: wall_t
       real(rp) :: normal(3) = 0.0_rp       !< unit normal pointing into the fluid (grid frame)
@@ -49,13 +62,20 @@ module boundary_walls
       !> the impulse of node nodes(i) counts here: this rank owns the node (no other rank counts it)
       logical, allocatable :: counted(:)
       real(rp), allocatable :: arm(:, :)   !< node position - moment_point (3, i), grid frame [m]
+      real(rp) :: friction = 0.0_rp        !< Coulomb coefficient mu of kind friction [-]
+      logical :: shaped = .false.          !< a structure: the surface of `shape`, a normal per node
+      type(shape_t) :: shape               !< shaped: the obstacle, world frame
+      !> shaped: grid-frame bounding box of the shape (the safeguard's quick rejection)
+      real(rp) :: box_lower(3) = -huge(1.0_rp), box_upper(3) = huge(1.0_rp)
+      real(rp), allocatable :: node_normal(:, :)   !< shaped: unit normal at node nodes(i) (dim, i), grid frame
    end type wall_t
 
    !> Rows of an impulse accumulator (impulse_rows, wall): force impulse (3), then moment impulse (3), grid frame.
    integer, parameter, public :: impulse_rows = 6
 
-   public :: build_walls, box_side_walls, make_wall, set_wall_activity, apply_wall_constraints, keep_particles_inside, &
-             behind_wall
+   public :: build_walls, box_side_walls, make_wall, make_structure, build_structures, set_wall_activity, &
+             apply_wall_constraints, keep_particles_inside, behind_wall, wall_distance, unilateral_velocity, &
+             first_particle_inside
 
 contains
 
@@ -77,12 +97,105 @@ contains
       integer :: w, kind
       allocate (walls(size(specs)))
       do w = 1, size(specs)
-         kind = wall_kind_slip
-         if (specs(w)%condition == wall_no_slip) kind = wall_kind_no_slip
+         kind = condition_kind(specs(w)%condition)
          walls(w) = make_wall(grid, specs(w)%point, specs(w)%normal, specs(w)%lower, specs(w)%upper, grid%h, kind, &
                               load=w, moment_point=specs(w)%moment_point)
+         walls(w)%friction = specs(w)%friction
       end do
    end subroutine build_walls_of
+
+   !> The wall kind of a condition keyword ('slip', 'no_slip', 'friction').
+   pure integer function condition_kind(condition) result(kind)
+      character(len=*), intent(in) :: condition
+      kind = wall_kind_slip
+      if (condition == wall_no_slip) kind = wall_kind_no_slip
+      if (condition == wall_friction) kind = wall_kind_friction
+   end function condition_kind
+
+   !> The structures of `&structure` groups appended to `walls`; structure s reports to loads.csv entry
+   !> first_load + s.
+   subroutine build_structures(specs, grid, first_load, walls)
+      type(structure_spec_t), intent(in) :: specs(:)
+      type(grid_t), intent(in) :: grid
+      integer, intent(in) :: first_load
+      type(wall_t), allocatable, intent(inout) :: walls(:)
+      type(wall_t), allocatable :: structures(:)
+      integer :: s
+      allocate (structures(size(specs)))
+      do s = 1, size(specs)
+         structures(s) = make_structure(grid, specs(s)%shape, condition_kind(specs(s)%condition), specs(s)%friction, &
+                                        first_load + s, specs(s)%moment_point)
+      end do
+      walls = [walls, structures]
+   end subroutine build_structures
+
+   !> A structure: the surface of the world-frame `shape` as a constraint of kind `kind` (friction mu), its
+   !> impulse to loads.csv entry `load` with the moment about the world point `moment_point`, and the local
+   !> nodes it constrains with the shape's outward normal at each (in the grid frame).
+   function make_structure(grid, shape, kind, friction, load, moment_point) result(wall)
+      type(grid_t), intent(in) :: grid
+      type(shape_t), intent(in) :: shape
+      integer, intent(in) :: kind, load
+      real(rp), intent(in) :: friction, moment_point(3)
+      type(wall_t) :: wall
+      integer :: dim, n, i, j, l, g(3), k, corner
+      integer, allocatable :: found(:)
+      logical, allocatable :: owned(:)
+      real(rp), allocatable :: normals(:, :)
+      real(rp) :: x(3), world(3), lower(3), upper(3), phi, reach
+
+      dim = grid%dim
+      wall%shaped = .true.
+      wall%shape = shape
+      wall%kind = kind
+      wall%friction = friction
+      wall%load = load
+      wall%depth = depth_in_cells * grid%h
+      wall%moment_point = 0.0_rp
+      wall%moment_point(1:dim) = grid%frame%grid_point(moment_point(1:dim))
+      ! the grid-frame box of the world box's corners holds the shape
+      call shape_bounds(shape, dim, lower, upper)
+      wall%box_lower = huge(1.0_rp)
+      wall%box_upper = -huge(1.0_rp)
+      do corner = 0, 2**dim - 1
+         do k = 1, dim
+            world(k) = merge(upper(k), lower(k), btest(corner, k - 1))
+         end do
+         x(1:dim) = grid%frame%grid_point(world(1:dim))
+         wall%box_lower(1:dim) = min(wall%box_lower(1:dim), x(1:dim))
+         wall%box_upper(1:dim) = max(wall%box_upper(1:dim), x(1:dim))
+      end do
+
+      allocate (found(grid%node_count), owned(grid%node_count), normals(dim, grid%node_count))
+      n = 0
+      x = 0.0_rp
+      reach = wall%depth + grid%h
+      do l = grid%node_lo(3), grid%node_hi(3)
+         do j = grid%node_lo(2), grid%node_hi(2)
+            do i = grid%node_lo(1), grid%node_hi(1)
+               g = [i, j, l]
+               x(1:dim) = grid%origin(1:dim) + g(1:dim) * grid%h
+               if (any(x(1:dim) < wall%box_lower(1:dim) - reach) .or. any(x(1:dim) > wall%box_upper(1:dim) + reach)) cycle
+               world(1:dim) = grid%frame%world_point(x(1:dim))
+               phi = shape_distance(shape, world(1:dim))
+               if (phi > on_wall_tolerance * grid%h .or. phi < -wall%depth) cycle
+               n = n + 1
+               found(n) = grid%local_node(g(1:dim))
+               owned(n) = grid%owns_node(g(1:dim))
+               normals(:, n) = grid%frame%grid_vector(shape_normal(shape, world(1:dim), normal_step_in_cells * grid%h))
+            end do
+         end do
+      end do
+      wall%nodes = found(1:n)
+      wall%counted = owned(1:n)
+      wall%node_normal = normals(:, 1:n)
+      allocate (wall%arm(3, n))
+      wall%arm = 0.0_rp
+      do i = 1, n
+         g(1:dim) = grid%node_indices(found(i))
+         wall%arm(1:dim, i) = grid%origin(1:dim) + g(1:dim) * grid%h - wall%moment_point(1:dim)
+      end do
+   end function make_structure
 
    !> The sides of the scene box that `&box_walls` makes walls, as `&wall` entries: each is the face of
    !> the box lower..lower + ncells h (world frame), with the normal pointing into the box.
@@ -98,6 +211,7 @@ contains
          do side = 1, 2
             if (grid%wall(side, k) == wall_none) cycle
             wall%condition = grid%wall(side, k)
+            wall%friction = grid%wall_friction
             wall%name = grid%wall_name(side, k)
             wall%normal = 0.0_rp
             wall%normal(k) = merge(1.0_rp, -1.0_rp, side == 1)
@@ -191,13 +305,26 @@ contains
       d = size(x)
       extra = 0.0_rp
       if (present(widen)) extra = widen
-      distance = dot_product(wall%normal(1:d), x - wall%point(1:d))
+      distance = wall_distance(wall, grid, x)
       behind = distance <= tolerance .and. distance >= -(wall%depth + extra)
-      if (.not. behind) return
+      if (.not. behind .or. wall%shaped) return
       foot = grid%frame%world_point(x - distance * wall%normal(1:d))
       behind = all(foot >= wall%lower(1:d) - (wall%margin + extra)) .and. &
                all(foot <= wall%upper(1:d) + (wall%margin + extra))
    end function behind_wall
+
+   !> Signed distance phi of the grid-frame point x from the wall's plane or the structure's surface
+   !> (negative behind it) [m].
+   real(rp) function wall_distance(wall, grid, x) result(distance)
+      type(wall_t), intent(in) :: wall
+      type(grid_t), intent(in) :: grid
+      real(rp), intent(in) :: x(:)
+      if (wall%shaped) then
+         distance = shape_distance(wall%shape, grid%frame%world_point(x))
+      else
+         distance = dot_product(wall%normal(1:size(x)), x - wall%point(1:size(x)))
+      end if
+   end function wall_distance
 
    !> Walls act during [active_from, active_until) only.
    pure subroutine set_wall_activity(walls, time)
@@ -209,11 +336,12 @@ contains
       end do
    end subroutine set_wall_activity
 
-   !> Constrain nodal velocities (eq. 14 for slip walls; zero for no-slip walls; v_0 for a feeder).
-   !> Walls are applied in turn, which is exact at a corner of two orthogonal walls (algorithms.md
-   !> section 4.1); a prescribed velocity, listed last, wins. With `mass` (nodal masses) and `impulse`,
-   !> impulse(:, w) gains the momentum wall w gives the counted nodes, m_i (v_i^c - v_i^*), and its moment
-   !> (algorithms.md section 9.1).
+   !> Constrain nodal velocities (eq. 14 for slip walls; Coulomb for friction; zero for no-slip walls; v_0
+   !> for a feeder). A planar wall has one normal, a structure one per node. Walls are applied in turn,
+   !> which is exact at a corner of two orthogonal walls (algorithms.md section 4.1); a prescribed velocity,
+   !> listed after the scene's walls, wins. With `mass` (nodal masses) and `impulse`, impulse(:, w) gains
+   !> the momentum wall w gives the counted nodes, m_i (v_i^c - v_i^*), and its moment (algorithms.md
+   !> section 9.1).
    pure subroutine apply_wall_constraints(walls, dim, velocity, mass, impulse)
       type(wall_t), intent(in) :: walls(:)
       integer, intent(in) :: dim
@@ -221,33 +349,61 @@ contains
       real(rp), intent(in), optional :: mass(:)
       real(rp), intent(inout), optional :: impulse(:, :)
       integer :: w, i, node
-      real(rp) :: vn, before(dim)
+      real(rp) :: vn, before(dim), n(dim)
       logical :: recording
       recording = present(mass) .and. present(impulse)
       do w = 1, size(walls)
          if (.not. walls(w)%active) cycle
-         associate (n => walls(w)%normal(1:dim))
-            do i = 1, size(walls(w)%nodes)
-               node = walls(w)%nodes(i)
-               before = velocity(:, node)
-               select case (walls(w)%kind)
-               case (wall_kind_no_slip)
-                  velocity(:, node) = 0.0_rp
-               case (wall_kind_prescribed)
-                  velocity(:, node) = walls(w)%velocity(1:dim)
-               case default
-                  vn = dot_product(before, n)
-                  if (vn >= 0.0_rp) cycle
-                  velocity(:, node) = before - vn * n
-               end select
-               if (recording) then
-                  if (walls(w)%counted(i)) call add_impulse(impulse(:, w), mass(node) * (velocity(:, node) - before), &
-                                                            walls(w)%arm(1:dim, i))
-               end if
-            end do
-         end associate
+         if (.not. walls(w)%shaped) n = walls(w)%normal(1:dim)
+         do i = 1, size(walls(w)%nodes)
+            node = walls(w)%nodes(i)
+            before = velocity(:, node)
+            if (walls(w)%shaped) n = walls(w)%node_normal(:, i)
+            select case (walls(w)%kind)
+            case (wall_kind_no_slip)
+               velocity(:, node) = 0.0_rp
+            case (wall_kind_prescribed)
+               velocity(:, node) = walls(w)%velocity(1:dim)
+            case (wall_kind_friction)
+               if (dot_product(before, n) >= 0.0_rp) cycle
+               velocity(:, node) = unilateral_velocity(before, n, walls(w)%friction)
+            case default
+               vn = dot_product(before, n)
+               if (vn >= 0.0_rp) cycle
+               velocity(:, node) = before - vn * n
+            end select
+            if (recording) then
+               if (walls(w)%counted(i)) call add_impulse(impulse(:, w), mass(node) * (velocity(:, node) - before), &
+                                                         walls(w)%arm(1:dim, i))
+            end if
+         end do
       end do
    end subroutine apply_wall_constraints
+
+   !> The velocity v after a unilateral contact with Coulomb friction mu against a surface of unit normal
+   !> n (pointing into the material): unchanged when separating (v.n >= 0); else the normal part v_n is
+   !> removed and the tangential part v_t shortened by mu |v_n|, to zero at most (it sticks when
+   !> |v_t| <= mu |v_n|, it is never reversed). Over a step this is the impulse of a normal force N dt =
+   !> m |v_n| with a friction impulse at most mu N dt opposing the sliding [R] (the grid-node form of
+   !> Bardenhagen et al. 2001's contact against a rigid surface, algorithms.md section 9.4).
+   pure function unilateral_velocity(v, n, mu) result(constrained)
+      real(rp), intent(in) :: v(:), n(:), mu
+      real(rp) :: constrained(size(v))
+      real(rp) :: vn, tangential(size(v)), speed, remaining
+      vn = dot_product(v, n)
+      if (vn >= 0.0_rp) then
+         constrained = v
+         return
+      end if
+      tangential = v - vn * n
+      speed = norm2(tangential)
+      remaining = speed + mu * vn
+      if (remaining <= 0.0_rp) then
+         constrained = 0.0_rp
+      else
+         constrained = tangential * (remaining / speed)
+      end if
+   end function unilateral_velocity
 
    !> impulse(1:3) += dp, impulse(4:6) += arm x dp (2-D: only the z component of the moment).
    pure subroutine add_impulse(impulse, dp, arm)
@@ -265,8 +421,9 @@ contains
    end subroutine add_impulse
 
    !> Particle safeguard (algorithms.md section 4.2): a particle found behind a wall (inside its extent
-   !> and depth) is put back onto it and loses its velocity component into the wall. Counts corrections;
-   !> impulse(:, w) gains the momentum (and its moment) that wall w gave the particles it corrected.
+   !> and depth) or inside a structure is put back onto its surface and loses its velocity component into
+   !> it (with friction also what Coulomb allows). Counts corrections; impulse(:, w) gains the momentum (and
+   !> its moment) that wall w gave the particles it corrected.
    subroutine keep_particles_inside(walls, grid, particles, corrections, impulse)
       type(wall_t), intent(in) :: walls(:)
       type(grid_t), intent(in) :: grid
@@ -274,12 +431,18 @@ contains
       integer, intent(inout) :: corrections
       real(rp), intent(inout) :: impulse(:, :)
       integer :: w, p, d
-      real(rp) :: distance, vn, lowest(3), highest(3)
+      real(rp) :: distance, vn, lowest(3), highest(3), before(particles%dim)
       d = particles%dim
       if (.not. any(walls%active)) return
       call position_bounds(particles, lowest, highest)
       do w = 1, size(walls)
          if (.not. walls(w)%active) cycle
+         if (walls(w)%shaped) then
+            ! no particle in the structure's box: skip the pass
+            if (any(highest(1:d) < walls(w)%box_lower(1:d)) .or. any(lowest(1:d) > walls(w)%box_upper(1:d))) cycle
+            call keep_outside_structure(walls(w), grid, particles, corrections, impulse(:, w))
+            cycle
+         end if
          if (walls(w)%axis > 0) then
             ! no particle behind it: skip the pass (the usual case; x - x0 is monotonic in x)
             associate (k => walls(w)%axis)
@@ -297,15 +460,81 @@ contains
                particles%x(:, p) = particles%x(:, p) - distance * n
                vn = dot_product(particles%v(:, p), n)
                if (vn < 0.0_rp) then
-                  particles%v(:, p) = particles%v(:, p) - vn * n
-                  call add_impulse(impulse(:, w), -particles%mass(p) * vn * n, &
-                                   particles%x(:, p) - walls(w)%moment_point(1:d))
+                  if (walls(w)%kind == wall_kind_friction) then
+                     before = particles%v(:, p)
+                     particles%v(:, p) = unilateral_velocity(before, n, walls(w)%friction)
+                     call add_impulse(impulse(:, w), particles%mass(p) * (particles%v(:, p) - before), &
+                                      particles%x(:, p) - walls(w)%moment_point(1:d))
+                  else
+                     particles%v(:, p) = particles%v(:, p) - vn * n
+                     call add_impulse(impulse(:, w), -particles%mass(p) * vn * n, &
+                                      particles%x(:, p) - walls(w)%moment_point(1:d))
+                  end if
                end if
                corrections = corrections + 1
             end do
          end associate
       end do
    end subroutine keep_particles_inside
+
+   !> The safeguard of a structure: a particle with phi < 0 moves to its foot point x - phi n on the
+   !> surface (n = grad phi at x) and loses its normal velocity into the structure (friction: Coulomb's
+   !> share of the tangential one too). Unlike a wall's, it acts at any depth: a structure is solid.
+   !> A particle put on a curved surface lands at phi = 0 only to round-off; counting it inside only below
+   !> -on_wall_tolerance h keeps the next step's decision (and its change of velocity) from depending on
+   !> that round-off, which differs with the number of ranks.
+   subroutine keep_outside_structure(wall, grid, particles, corrections, impulse)
+      type(wall_t), intent(in) :: wall
+      type(grid_t), intent(in) :: grid
+      type(particle_set_t), intent(inout) :: particles
+      integer, intent(inout) :: corrections
+      real(rp), intent(inout) :: impulse(:)
+      integer :: p, d
+      real(rp) :: world(particles%dim), phi, n(particles%dim), before(particles%dim), step, tolerance
+      d = particles%dim
+      step = normal_step_in_cells * grid%h
+      tolerance = on_wall_tolerance * grid%h
+      do p = 1, particles%count
+         if (any(particles%x(:, p) < wall%box_lower(1:d)) .or. any(particles%x(:, p) > wall%box_upper(1:d))) cycle
+         world = grid%frame%world_point(particles%x(:, p))
+         phi = shape_distance(wall%shape, world)
+         if (phi >= -tolerance) cycle
+         n = grid%frame%grid_vector(shape_normal(wall%shape, world, step))
+         particles%x(:, p) = particles%x(:, p) - phi * n
+         if (dot_product(particles%v(:, p), n) < 0.0_rp) then
+            before = particles%v(:, p)
+            if (wall%kind == wall_kind_friction) then
+               particles%v(:, p) = unilateral_velocity(before, n, wall%friction)
+            else
+               particles%v(:, p) = before - dot_product(before, n) * n
+            end if
+            call add_impulse(impulse, particles%mass(p) * (particles%v(:, p) - before), &
+                             particles%x(:, p) - wall%moment_point(1:d))
+         end if
+         corrections = corrections + 1
+      end do
+   end subroutine keep_outside_structure
+
+   !> The first of the local particles that lies inside the structure `wall` (phi < 0), 0 if none; its
+   !> depth -phi [m].
+   integer function first_particle_inside(wall, grid, particles, depth) result(found)
+      type(wall_t), intent(in) :: wall
+      type(grid_t), intent(in) :: grid
+      type(particle_set_t), intent(in) :: particles
+      real(rp), intent(out) :: depth
+      integer :: p
+      real(rp) :: phi
+      found = 0
+      depth = 0.0_rp
+      do p = 1, particles%count
+         phi = wall_distance(wall, grid, particles%x(:, p))
+         if (phi < 0.0_rp) then
+            found = p
+            depth = -phi
+            return
+         end if
+      end do
+   end function first_particle_inside
 
    !> Smallest and largest particle coordinate along each axis (one pass that vectorises; huge / -huge
    !> without particles).
@@ -340,9 +569,15 @@ contains
          if (.not. behind_wall(wall, grid, particles%x(:, p), 0.0_rp)) cycle
          particles%x(k, p) = x0
          if (sense * particles%v(k, p) < 0.0_rp) then
-            dp = 0.0_rp
-            dp(k) = -particles%mass(p) * particles%v(k, p)
-            particles%v(k, p) = 0.0_rp
+            if (wall%kind == wall_kind_friction) then
+               dp = particles%v(:, p)
+               particles%v(:, p) = unilateral_velocity(dp, wall%normal(1:particles%dim), wall%friction)
+               dp = particles%mass(p) * (particles%v(:, p) - dp)
+            else
+               dp = 0.0_rp
+               dp(k) = -particles%mass(p) * particles%v(k, p)
+               particles%v(k, p) = 0.0_rp
+            end if
             call add_impulse(impulse, dp, particles%x(:, p) - wall%moment_point(1:particles%dim))
          end if
          corrections = corrections + 1

@@ -21,7 +21,7 @@ contains
       type(MPI_Comm), intent(in) :: comm
       integer, intent(in) :: root
       character(len=1), allocatable :: bytes(:)
-      integer :: counts(6), rank_count(6), rank, n, at
+      integer :: counts(7), rank_count(7), rank, n, at
 
       ! -1 stands for "not allocated".
       counts = -1
@@ -31,6 +31,7 @@ contains
       if (allocated(scene%inlets)) counts(4) = size(scene%inlets)
       if (allocated(scene%gauges)) counts(5) = size(scene%gauges)
       if (allocated(scene%contacts)) counts(6) = size(scene%contacts)
+      if (allocated(scene%structures)) counts(7) = size(scene%structures)
       rank_count = counts
       call MPI_Bcast(counts, size(counts), MPI_INTEGER, root, comm)
       if (any(counts /= rank_count)) then
@@ -40,12 +41,14 @@ contains
          if (allocated(scene%inlets)) deallocate (scene%inlets)
          if (allocated(scene%gauges)) deallocate (scene%gauges)
          if (allocated(scene%contacts)) deallocate (scene%contacts)
+         if (allocated(scene%structures)) deallocate (scene%structures)
          if (counts(1) >= 0) allocate (scene%materials(counts(1)))
          if (counts(2) >= 0) allocate (scene%bodies(counts(2)))
          if (counts(3) >= 0) allocate (scene%walls(counts(3)))
          if (counts(4) >= 0) allocate (scene%inlets(counts(4)))
          if (counts(5) >= 0) allocate (scene%gauges(counts(5)))
          if (counts(6) >= 0) allocate (scene%contacts(counts(6)))
+         if (counts(7) >= 0) allocate (scene%structures(counts(7)))
       end if
 
       ! the parts one after the other, packed on root and unpacked in the same order elsewhere
@@ -60,6 +63,7 @@ contains
          if (counts(4) > 0) bytes = [bytes, transfer(scene%inlets, byte_mold)]
          if (counts(5) > 0) bytes = [bytes, transfer(scene%gauges, byte_mold)]
          if (counts(6) > 0) bytes = [bytes, transfer(scene%contacts, byte_mold)]
+         if (counts(7) > 0) bytes = [bytes, transfer(scene%structures, byte_mold)]
          n = size(bytes)
       end if
       call MPI_Bcast(n, 1, MPI_INTEGER, root, comm)
@@ -84,6 +88,8 @@ contains
                                                     scene%gauges, counts(5))
       if (counts(6) > 0) scene%contacts(:) = transfer(next_bytes(counts(6) * size(transfer(scene%contacts(1), &
                                                       byte_mold))), scene%contacts, counts(6))
+      if (counts(7) > 0) scene%structures(:) = transfer(next_bytes(counts(7) * size(transfer(scene%structures(1), &
+                                                        byte_mold))), scene%structures, counts(7))
 
    contains
 

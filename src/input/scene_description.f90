@@ -2,6 +2,7 @@
 !> (documented group by group in docs/input.md). Only what is declared is modelled.
 module scene_description
    use kinds, only: rp, i8, path_len, name_len
+   use shape_geometry, only: shape_t
    implicit none
    private
 
@@ -15,6 +16,8 @@ module scene_description
    character(len=*), parameter, public :: wall_none = 'none'
    character(len=*), parameter, public :: wall_slip = 'slip'      ! [Y17] eq. 14, unilateral, frictionless
    character(len=*), parameter, public :: wall_no_slip = 'no_slip'
+   !> Unilateral with Coulomb friction (`&wall`, `&box_walls`, `&structure` with `friction` = mu).
+   character(len=*), parameter, public :: wall_friction = 'friction'
 
    !> Material model keywords (`&material model=`).
    character(len=*), parameter, public :: model_newtonian_fluid = 'newtonian_fluid'
@@ -67,6 +70,7 @@ module scene_description
       !> name of each side's wall in loads.csv (`&box_walls x_min_name` ...); resolved default 'x_min' ...
       !> for a side that is a wall, '' for an open side
       character(len=name_len) :: wall_name(2, 3) = ''
+      real(rp) :: wall_friction = 0.0_rp      !< Coulomb mu of the sides whose condition is 'friction'
    end type grid_spec_t
 
    !> `&wall`: a plane wall (a segment in 2-D, a planar patch in 3-D), world frame. The wall is the part
@@ -78,11 +82,27 @@ module scene_description
       real(rp) :: lower(3) = -huge(1.0_rp)    !< extent of the wall: lower corner of its bounding box [m]
       real(rp) :: upper(3) = huge(1.0_rp)     !< upper corner [m]
       character(len=name_len) :: condition = wall_slip
+      real(rp) :: friction = 0.0_rp           !< Coulomb coefficient mu of condition 'friction' [-]
       character(len=name_len) :: name = ''    !< name in loads.csv; resolved default 'wall_<k>'
       !> point the moment of the wall's load is taken about [m]; huge: not given, resolved to the component
       !> of `point`
       real(rp) :: moment_point(3) = huge(1.0_rp)
    end type wall_spec_t
+
+   !> `&structure`: a fixed rigid obstacle of any shape and orientation (world frame) whose surface
+   !> constrains the material like a wall (unilateral; slip, no-slip or Coulomb friction).
+   type, public :: structure_spec_t
+      character(len=name_len) :: name = ''    !< name in loads.csv; resolved default 'structure_<k>'
+      type(shape_t) :: shape                  !< the obstacle (shape_geometry: negative distance inside)
+      !> box: corners lower..upper as an alternative to centre and size (huge: not given; resolved into
+      !> the shape and cleared)
+      real(rp) :: lower(3) = huge(1.0_rp)
+      real(rp) :: upper(3) = huge(1.0_rp)
+      character(len=name_len) :: condition = wall_slip
+      real(rp) :: friction = 0.0_rp           !< Coulomb coefficient mu of condition 'friction' [-]
+      !> point the moment of its load is taken about [m]; huge: not given, resolved to the shape's centre
+      real(rp) :: moment_point(3) = huge(1.0_rp)
+   end type structure_spec_t
 
    !> `&inlet`: an opening through which fluid enters at a constant speed (algorithms.md section 4.3).
    !> The opening lies in the plane through `point` normal to `direction` (the flow direction, world
@@ -171,6 +191,7 @@ module scene_description
       type(material_spec_t), allocatable :: materials(:)
       type(body_spec_t), allocatable :: bodies(:)
       type(wall_spec_t), allocatable :: walls(:)      !< `&wall` groups (the `&box_walls` sides are in grid)
+      type(structure_spec_t), allocatable :: structures(:)   !< `&structure` groups
       type(inlet_spec_t), allocatable :: inlets(:)
       type(gauge_spec_t), allocatable :: gauges(:)
       type(contact_spec_t), allocatable :: contacts(:)

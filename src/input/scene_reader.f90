@@ -6,12 +6,15 @@
 !> (which start from the scene's current values), the repeated groups, the checks that the base file
 !> gives every required variable, and finally `validate_scene` / `resolve_scene` on the whole scene.
 module scene_reader
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_size
    use memory_budget, only: memory_budget_t, measure_memory_budget
    use kinds, only: rp, i8, path_len
    use error_status, only: status_t
    use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
-                                inlet_spec_t, gauge_spec_t, contact_spec_t, model_newtonian_fluid, model_linear_elastic
+                                inlet_spec_t, gauge_spec_t, structure_spec_t, contact_spec_t, model_newtonian_fluid, &
+                                model_linear_elastic
+   use shape_geometry, only: max_vertices, no_vertex
    use namelist_scan, only: namelist_file_t, namelist_group_t, scan_namelist_file
    use scene_validation, only: validate_scene, resolve_scene, check_scene_memory, default_name, stabilization_keywords, &
                                oscillation_rule_keywords
@@ -40,12 +43,12 @@ module scene_reader
    !> The namelist groups of a scene file, in the order a resolved scene is written (scene_record).
    character(len=*), parameter, public :: known_groups(*) = &
       [character(len=9) :: 'run', 'grid', 'box_walls', 'gravity', 'material', 'body', 'wall', 'inlet', 'gauge', &
-                           'contact']
+                           'structure', 'contact']
    !> Groups that may appear at most once.
    character(len=*), parameter :: singleton_groups(*) = [character(len=9) :: 'run', 'grid', 'box_walls', 'gravity']
    !> Groups that may appear any number of times, one scene entry each.
    character(len=*), parameter, public :: repeated_groups(*) = &
-      [character(len=8) :: 'material', 'body', 'wall', 'inlet', 'gauge', 'contact']
+      [character(len=9) :: 'material', 'body', 'wall', 'inlet', 'gauge', 'structure', 'contact']
    !> Groups a scene file must contain.
    character(len=*), parameter :: required_groups(*) = [character(len=8) :: 'run', 'grid', 'material']
 
@@ -53,7 +56,7 @@ module scene_reader
    type :: variable_info_t
       character(len=9) :: group
       character(len=26) :: name
-      character(len=7) :: kind          !< real, real3, integer, logical, string or string2 (two strings)
+      character(len=7) :: kind          !< real, real3, reals, integer, logical, string or string2 (two strings)
       logical :: required
    end type variable_info_t
 
@@ -98,6 +101,7 @@ module scene_reader
       variable_info_t('box_walls', 'y_max_name', 'string', .false.), &
       variable_info_t('box_walls', 'z_min_name', 'string', .false.), &
       variable_info_t('box_walls', 'z_max_name', 'string', .false.), &
+      variable_info_t('box_walls', 'friction', 'real', .false.), &
       variable_info_t('gravity', 'acceleration', 'real3', .false.), &
       variable_info_t('material', 'name', 'string', .true.), &
       variable_info_t('material', 'model', 'string', .true.), &
@@ -128,6 +132,7 @@ module scene_reader
       variable_info_t('wall', 'lower', 'real3', .false.), &
       variable_info_t('wall', 'upper', 'real3', .false.), &
       variable_info_t('wall', 'condition', 'string', .false.), &
+      variable_info_t('wall', 'friction', 'real', .false.), &
       variable_info_t('wall', 'name', 'string', .false.), &
       variable_info_t('wall', 'moment_point', 'real3', .false.), &
       variable_info_t('inlet', 'name', 'string', .false.), &
@@ -146,7 +151,23 @@ module scene_reader
       variable_info_t('gauge', 'point', 'real3', .true.), &
       variable_info_t('gauge', 'radius', 'real', .false.), &
       variable_info_t('contact', 'between', 'string2', .true.), &
-      variable_info_t('contact', 'friction', 'real', .false.)]
+      variable_info_t('contact', 'friction', 'real', .false.), &
+      variable_info_t('structure', 'name', 'string', .false.), &
+      variable_info_t('structure', 'shape', 'string', .false.), &
+      variable_info_t('structure', 'centre', 'real3', .false.), &
+      variable_info_t('structure', 'size', 'real3', .false.), &
+      variable_info_t('structure', 'rotation', 'real', .false.), &
+      variable_info_t('structure', 'rotation_axis', 'real3', .false.), &
+      variable_info_t('structure', 'radius', 'real', .false.), &
+      variable_info_t('structure', 'axis', 'real3', .false.), &
+      variable_info_t('structure', 'length', 'real', .false.), &
+      variable_info_t('structure', 'vertices', 'reals', .false.), &
+      variable_info_t('structure', 'z_range', 'reals', .false.), &
+      variable_info_t('structure', 'lower', 'real3', .false.), &
+      variable_info_t('structure', 'upper', 'real3', .false.), &
+      variable_info_t('structure', 'condition', 'string', .false.), &
+      variable_info_t('structure', 'friction', 'real', .false.), &
+      variable_info_t('structure', 'moment_point', 'real3', .false.)]
 
    !> Namelist buffers of string values are longer than the scene's fields, so that a value too long
    !> for its field is reported instead of cut.
@@ -286,7 +307,8 @@ contains
       if (.not. status%ok) return
       call read_singleton_groups(file, scene, status)
       if (.not. status%ok) return
-      allocate (probe%materials(1), probe%bodies(1), probe%walls(1), probe%inlets(1), probe%gauges(1), probe%contacts(1))
+      allocate (probe%materials(1), probe%bodies(1), probe%walls(1), probe%inlets(1), probe%gauges(1), &
+                probe%structures(1), probe%contacts(1))
       do g = 1, size(file%groups)
          group = file%groups(g)%name
          if (.not. any(repeated_groups == group)) cycle
@@ -330,7 +352,7 @@ contains
       character(len=*), intent(in) :: group
       character(len=:), allocatable :: name
       select case (group)
-      case ('material', 'wall', 'gauge')
+      case ('material', 'wall', 'gauge', 'structure')
          name = 'name'
       case ('body', 'inlet')
          name = 'material'
@@ -361,6 +383,10 @@ contains
          if (len(value) == 0) value = default_name('wall', i)
       case ('gauge')
          value = trim(scene%gauges(i)%name)
+      case ('structure')
+         ! an unnamed structure is selected by its default name (structure_<k>)
+         value = trim(scene%structures(i)%name)
+         if (len(value) == 0) value = default_name('structure', i)
       case default
          value = ''
       end select
@@ -386,6 +412,8 @@ contains
          if (allocated(scene%gauges)) n = size(scene%gauges)
       case ('contact')
          if (allocated(scene%contacts)) n = size(scene%contacts)
+      case ('structure')
+         if (allocated(scene%structures)) n = size(scene%structures)
       end select
    end function entry_count
 
@@ -502,14 +530,16 @@ contains
       type(inlet_spec_t) :: default_inlet
       type(gauge_spec_t) :: default_gauge
       type(contact_spec_t) :: default_contact
+      type(structure_spec_t) :: default_structure
       character(len=512) :: message
       character(len=:), allocatable :: group
       integer :: g, k, ios
 
       allocate (scene%materials(file%count('material')), scene%bodies(file%count('body')), &
                 scene%walls(file%count('wall')), scene%inlets(file%count('inlet')), scene%gauges(file%count('gauge')), &
-                scene%contacts(file%count('contact')))
-      allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1), one%gauges(1), one%contacts(1))
+                scene%structures(file%count('structure')), scene%contacts(file%count('contact')))
+      allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1), one%gauges(1), one%structures(1), &
+                one%contacts(1))
       do g = 1, size(repeated_groups)
          group = trim(repeated_groups(g))
          do k = 1, file%count(group)
@@ -519,6 +549,7 @@ contains
             one%inlets(1) = default_inlet
             one%gauges(1) = default_gauge
             one%contacts(1) = default_contact
+            one%structures(1) = default_structure
             message = ''
             call read_group(group, one, 1, ios, message, file%groups(file%find(group, k))%text())
             if (ios /= 0) then
@@ -538,6 +569,8 @@ contains
                scene%gauges(k) = one%gauges(1)
             case ('contact')
                scene%contacts(k) = one%contacts(1)
+            case ('structure')
+               scene%structures(k) = one%structures(1)
             end select
          end do
       end do
@@ -567,6 +600,8 @@ contains
             where = group_context(file%path, group, k, name_detail(scene%gauges(k)%name))
          case ('contact')
             where = group_context(file%path, group, k)
+         case ('structure')
+            where = group_context(file%path, group, k, name_detail(scene%structures(k)%name))
          case default
             where = group_context(file%path, group, 0)
          end select
@@ -637,7 +672,8 @@ contains
          call status%fail(file%path//': group &'//group//label//': '//trim(message))
          return
       end if
-      allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1), one%gauges(1), one%contacts(1))
+      allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1), one%gauges(1), one%structures(1), &
+                one%contacts(1))
       associate (items => file%groups(g)%items)
          do i = 1, size(items)
             prefix = file%path//': line '//int_text(items(i)%line)//': group &'//group//label
@@ -716,6 +752,9 @@ contains
          text = 'a real number'
       case ('real3')
          text = 'up to 3 real numbers'
+      case ('reals')
+         text = 'a list of real numbers (vertices: x1, y1, x2, y2, ..., at most '//int_text(max_vertices)// &
+                ' vertices; z_range: 2 numbers)'
       case ('integer')
          text = 'an integer (no decimal point or exponent)'
       case ('logical')
@@ -761,6 +800,8 @@ contains
          call read_gauge_group(scene%gauges(k), ios, message, text)
       case ('contact')
          call read_contact_group(scene%contacts(k), ios, message, text)
+      case ('structure')
+         call read_structure_group(scene%structures(k), ios, message, text)
       case default
          ios = value_too_long
          message = 'no namelist group &'//group
@@ -907,9 +948,10 @@ contains
       character(len=text_len) :: sides(2, 3), names(2, 3)
       character(len=*), parameter :: side_variables(2, 3) = reshape([character(len=5) :: 'x_min', 'x_max', &
                                                                      'y_min', 'y_max', 'z_min', 'z_max'], [2, 3])
+      real(rp) :: friction
       integer :: s, d
       namelist /box_walls/ x_min, x_max, y_min, y_max, z_min, z_max, &
-         x_min_name, x_max_name, y_min_name, y_max_name, z_min_name, z_max_name
+         x_min_name, x_max_name, y_min_name, y_max_name, z_min_name, z_max_name, friction
 
       x_min = spec%wall(1, 1)
       x_max = spec%wall(2, 1)
@@ -923,6 +965,7 @@ contains
       y_max_name = spec%wall_name(2, 2)
       z_min_name = spec%wall_name(1, 3)
       z_max_name = spec%wall_name(2, 3)
+      friction = spec%wall_friction
       read (text, nml=box_walls, iostat=ios, iomsg=message)
       sides = reshape([character(len=text_len) :: x_min, x_max, y_min, y_max, z_min, z_max], [2, 3])
       names = reshape([character(len=text_len) :: x_min_name, x_max_name, y_min_name, y_max_name, z_min_name, &
@@ -937,6 +980,7 @@ contains
             call take_text(side_variables(s, d)//'_name', names(s, d), spec%wall_name(s, d), ios, message)
          end do
       end do
+      if (ios == 0) spec%wall_friction = friction
    end subroutine read_box_walls_group
 
    subroutine read_gravity_group(vector, ios, message, text)
@@ -1041,14 +1085,15 @@ contains
       character(len=*), intent(inout) :: message
       character(len=*), intent(in) :: text
       character(len=text_len) :: condition, name
-      real(rp) :: point(3), normal(3), lower(3), upper(3), moment_point(3)
-      namelist /wall/ point, normal, lower, upper, condition, name, moment_point
+      real(rp) :: point(3), normal(3), lower(3), upper(3), moment_point(3), friction
+      namelist /wall/ point, normal, lower, upper, condition, friction, name, moment_point
 
       point = spec%point
       normal = spec%normal
       lower = spec%lower
       upper = spec%upper
       condition = spec%condition
+      friction = spec%friction
       name = spec%name
       moment_point = spec%moment_point
       read (text, nml=wall, iostat=ios, iomsg=message)
@@ -1059,8 +1104,65 @@ contains
       spec%normal = normal
       spec%lower = lower
       spec%upper = upper
+      spec%friction = friction
       spec%moment_point = moment_point
    end subroutine read_wall_group
+
+   !> `vertices` is a flat list x1, y1, x2, y2, ...: a list that is given replaces the whole polygon (an
+   !> override with fewer vertices must not keep the old ones beyond it).
+   subroutine read_structure_group(spec, ios, message, text)
+      type(structure_spec_t), intent(inout) :: spec
+      integer, intent(out) :: ios
+      character(len=*), intent(inout) :: message
+      character(len=*), intent(in) :: text
+      character(len=text_len) :: name, shape, condition
+      real(rp) :: centre(3), size(3), rotation, rotation_axis(3), radius, axis(3), length, vertices(2 * max_vertices), &
+                  z_range(2), lower(3), upper(3), friction, moment_point(3)
+      namelist /structure/ name, shape, centre, size, rotation, rotation_axis, radius, axis, length, vertices, z_range, &
+         lower, upper, condition, friction, moment_point
+
+      name = spec%name
+      shape = spec%shape%kind
+      centre = spec%shape%centre
+      size = spec%shape%size
+      rotation = spec%shape%rotation
+      rotation_axis = spec%shape%rotation_axis
+      radius = spec%shape%radius
+      axis = spec%shape%axis
+      length = spec%shape%length
+      vertices = no_vertex
+      z_range = spec%shape%z_range
+      lower = spec%lower
+      upper = spec%upper
+      condition = spec%condition
+      friction = spec%friction
+      moment_point = spec%moment_point
+      read (text, nml=structure, iostat=ios, iomsg=message)
+      call take_text('name', name, spec%name, ios, message)
+      call take_text('shape', shape, spec%shape%kind, ios, message, fold='lower')
+      call take_text('condition', condition, spec%condition, ios, message, fold='lower')
+      if (ios /= 0) return
+      spec%shape%centre = centre
+      spec%shape%size = size
+      spec%shape%rotation = rotation
+      spec%shape%rotation_axis = rotation_axis
+      spec%shape%radius = radius
+      spec%shape%axis = axis
+      spec%shape%length = length
+      if (any(vertex_given(vertices))) spec%shape%vertices = reshape(vertices, [2, max_vertices])
+      spec%shape%z_range = z_range
+      spec%lower = lower
+      spec%upper = upper
+      spec%friction = friction
+      spec%moment_point = moment_point
+   end subroutine read_structure_group
+
+   !> A value of a vertex list that is not the 'none' marker (a NaN is given: validation reports it).
+   elemental logical function vertex_given(value) result(given)
+      real(rp), intent(in) :: value
+      given = .true.
+      if (ieee_is_finite(value)) given = value < no_vertex
+   end function vertex_given
 
    subroutine read_inlet_group(spec, ios, message, text)
       type(inlet_spec_t), intent(inout) :: spec

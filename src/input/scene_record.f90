@@ -10,6 +10,7 @@
 module scene_record
    use kinds, only: rp
    use scene_description, only: scene_t
+   use shape_geometry, only: no_vertex
    use scene_reader, only: known_groups, group_variables, entry_count
    use input_text, only: int_text, real_text
    implicit none
@@ -105,6 +106,8 @@ contains
          text = gauge_value(scene, k, name)
       case ('contact')
          text = contact_value(scene, k, name)
+      case ('structure')
+         text = structure_value(scene, k, name)
       case default
          text = ''
       end select
@@ -188,13 +191,17 @@ contains
       end associate
    end function grid_value
 
-   !> `x_min` ... `z_max`: the side's condition; `x_min_name` ...: its name.
+   !> `x_min` ... `z_max`: the side's condition; `x_min_name` ...: its name; `friction`: the sides' mu.
    function box_walls_value(scene, name) result(text)
       type(scene_t), intent(in) :: scene
       character(len=*), intent(in) :: name
       character(len=:), allocatable :: text
       integer :: axis, side
       text = ''
+      if (name == 'friction') then
+         text = real_text(scene%grid%wall_friction)
+         return
+      end if
       if (len(name) < 5) return
       axis = index(axis_letters, name(1:1))
       side = 0
@@ -299,6 +306,8 @@ contains
             text = reals(wall%upper)
          case ('condition')
             text = quoted(wall%condition)
+         case ('friction')
+            text = real_text(wall%friction)
          case ('name')
             text = quoted(wall%name)
          case ('moment_point')
@@ -381,6 +390,71 @@ contains
          end select
       end associate
    end function contact_value
+
+   function structure_value(scene, k, name) result(text)
+      type(scene_t), intent(in) :: scene
+      integer, intent(in) :: k
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: text
+      associate (structure => scene%structures(k), shape => scene%structures(k)%shape)
+         select case (name)
+         case ('name')
+            text = quoted(structure%name)
+         case ('shape')
+            text = quoted(shape%kind)
+         case ('centre')
+            text = reals(shape%centre)
+         case ('size')
+            text = reals(shape%size)
+         case ('rotation')
+            text = real_text(shape%rotation)
+         case ('rotation_axis')
+            text = reals(shape%rotation_axis)
+         case ('radius')
+            text = real_text(shape%radius)
+         case ('axis')
+            text = reals(shape%axis)
+         case ('length')
+            text = real_text(shape%length)
+         case ('vertices')
+            text = vertex_list(shape%vertices)
+         case ('z_range')
+            text = reals(shape%z_range)
+         case ('lower')
+            text = reals(structure%lower)
+         case ('upper')
+            text = reals(structure%upper)
+         case ('condition')
+            text = quoted(structure%condition)
+         case ('friction')
+            text = real_text(structure%friction)
+         case ('moment_point')
+            text = reals(structure%moment_point)
+         case default
+            text = ''
+         end select
+      end associate
+   end function structure_value
+
+   !> The vertices given, as the flat list x1, y1, x2, y2, ... that `vertices` reads; without any, the one
+   !> value that stands for none (shape_geometry's no_vertex), so that the text still reads back.
+   function vertex_list(vertices) result(text)
+      real(rp), intent(in) :: vertices(:, :)
+      character(len=:), allocatable :: text
+      real(rp), allocatable :: flat(:)
+      integer :: n
+      flat = reshape(vertices, [size(vertices)])
+      n = 0
+      do while (n < size(flat))
+         if (flat(n + 1) >= no_vertex) exit
+         n = n + 1
+      end do
+      if (n == 0) then
+         text = real_text(no_vertex)
+      else
+         text = reals(flat(1:n))
+      end if
+   end function vertex_list
 
    !> 'text' with an apostrophe doubled, trailing blanks removed.
    pure function quoted(value) result(text)

@@ -7,11 +7,15 @@ module scene_validation
    use kinds, only: rp, i8, name_len
    use error_status, only: status_t
    use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
-                                inlet_spec_t, gauge_spec_t, contact_spec_t, opening_far_end, wall_none, wall_slip, wall_no_slip, &
+                                inlet_spec_t, gauge_spec_t, contact_spec_t, structure_spec_t, opening_far_end, wall_none, &
+                                wall_slip, wall_no_slip, wall_friction, &
                                 model_newtonian_fluid, model_linear_elastic, gauge_pressure, gauge_level, gauge_velocity, &
                                 particle_field_names, field_precision_keywords
    use input_text, only: int_text, real_text, quoted_list, group_context, ordinal
    use memory_budget, only: memory_budget_t, byte_text
+   use shape_geometry, only: shape_t, shape_problem, shape_bounds, box_from_corners, polygon_vertices, polygon_area, &
+                             max_vertices, no_vertex, shape_box, shape_circle, shape_sphere, shape_cylinder, &
+                             shape_polygon, shape_extruded_polygon
    implicit none
    private
 
@@ -40,9 +44,11 @@ module scene_validation
    !> Accepted `&run update_scheme=` keywords (stored upper case).
    character(len=*), parameter, public :: update_scheme_keywords(*) = [character(len=4) :: 'USL', 'MUSL']
    !> Accepted `&box_walls` keywords (stored lower case).
-   character(len=*), parameter, public :: wall_keywords(*) = [character(len=7) :: wall_none, wall_slip, wall_no_slip]
-   !> Accepted `&wall condition=` keywords (stored lower case).
-   character(len=*), parameter, public :: wall_condition_keywords(*) = [character(len=7) :: wall_slip, wall_no_slip]
+   character(len=*), parameter, public :: wall_keywords(*) = [character(len=8) :: wall_none, wall_slip, wall_no_slip, &
+                                                              wall_friction]
+   !> Accepted `&wall condition=` and `&structure condition=` keywords (stored lower case).
+   character(len=*), parameter, public :: wall_condition_keywords(*) = [character(len=8) :: wall_slip, wall_no_slip, &
+                                                                        wall_friction]
    !> Accepted `&material model=` keywords (stored lower case).
    character(len=*), parameter, public :: model_keywords(*) = &
       [character(len=15) :: model_newtonian_fluid, model_linear_elastic]
@@ -109,6 +115,12 @@ contains
       if (allocated(scene%walls)) then
          do w = 1, size(scene%walls)
             call validate_wall(scene%walls(w), w, scene%grid%dim, path, status)
+            if (.not. status%ok) return
+         end do
+      end if
+      if (allocated(scene%structures)) then
+         do i = 1, size(scene%structures)
+            call validate_structure(scene%structures(i), i, scene%grid, path, status)
             if (.not. status%ok) return
          end do
       end if
@@ -267,6 +279,12 @@ contains
       if (allocated(scene%walls)) wall_count = size(scene%walls)
    end function wall_count
 
+   pure integer function structure_count(scene)
+      type(scene_t), intent(in) :: scene
+      structure_count = 0
+      if (allocated(scene%structures)) structure_count = size(scene%structures)
+   end function structure_count
+
    pure integer function inlet_count(scene)
       type(scene_t), intent(in) :: scene
       inlet_count = 0
@@ -323,6 +341,21 @@ contains
             scene%contacts(i)%material_index(k) = find_material(scene%materials, scene%contacts(i)%between(k))
          end do
       end do
+      if (.not. allocated(scene%structures)) allocate (scene%structures(0))
+      do i = 1, size(scene%structures)
+         associate (structure => scene%structures(i))
+            if (len_trim(structure%name) == 0) structure%name = default_name('structure', i)
+            ! a box given by its corners becomes centre and size (validated: both corners, no centre/size)
+            if (structure%lower(1) < huge(1.0_rp)) then
+               structure%shape = box_corners(structure%shape, structure%lower, structure%upper, scene%grid%dim)
+               structure%lower = huge(1.0_rp)
+               structure%upper = huge(1.0_rp)
+            end if
+            ! each component not given is the shape's centre's
+            where (structure%moment_point >= huge(1.0_rp)) structure%moment_point = shape_centre(structure%shape, &
+                                                                                                 scene%grid%dim)
+         end associate
+      end do
       if (.not. allocated(scene%gauges)) allocate (scene%gauges(0))
       do g = 1, size(scene%gauges)
          associate (gauge => scene%gauges(g))
@@ -338,8 +371,34 @@ contains
       end do
    end subroutine resolve_scene
 
+   !> The point a structure's moment is taken about by default: the centre of a box, circle, sphere or
+   !> cylinder, the centroid of a polygon's area (of an extruded polygon: at mid z_range), so that the
+   !> buoyancy of a submerged structure has no moment about it.
+   pure function shape_centre(shape, dim) result(centre)
+      type(shape_t), intent(in) :: shape
+      integer, intent(in) :: dim
+      real(rp) :: centre(3)
+      real(rp), allocatable :: v(:, :)
+      real(rp) :: area, cross
+      integer :: k, n
+      centre = shape%centre
+      if (shape%kind /= shape_polygon .and. shape%kind /= shape_extruded_polygon) return
+      v = polygon_vertices(shape)
+      n = size(v, 2)
+      area = polygon_area(v)
+      centre = 0.0_rp
+      do k = 1, n
+         associate (a => v(:, k), b => v(:, modulo(k, n) + 1))
+            cross = a(1) * b(2) - b(1) * a(2)
+            centre(1:2) = centre(1:2) + (a + b) * cross
+         end associate
+      end do
+      centre(1:2) = centre(1:2) / (6.0_rp * area)
+      if (dim == 3) centre(3) = 0.5_rp * (shape%z_range(1) + shape%z_range(2))
+   end function shape_centre
+
    !> Default name of the k-th entry of a repeated group that carries loads: `wall_<k>`, `inlet_<k>`,
-   !> `body_<k>`.
+   !> `body_<k>`, `structure_<k>`.
    pure function default_name(group, k) result(name)
       character(len=*), intent(in) :: group
       integer, intent(in) :: k
@@ -550,6 +609,11 @@ contains
             end if
          end do
       end do
+      call check_real(where, 'friction', grid%wall_friction, status, at_least=0.0_rp)
+      if (status%ok .and. grid%wall_friction > 0.0_rp .and. all(grid%wall /= wall_friction)) &
+         call status%fail(where//': variable friction is the Coulomb coefficient of the sides whose condition is '''// &
+                          wall_friction//"', and no side is: give a side 'friction' or leave friction out")
+      if (.not. status%ok) return
       ! a name labels the loads of a wall: an open side has none
       do k = 1, 3
          do side = 1, 2
@@ -751,7 +815,166 @@ contains
          call status%fail(where//': variable condition must be one of '//quoted_list(wall_condition_keywords)// &
                           ", got '"//trim(wall%condition)//"'")
       end if
+      call check_friction(where, wall%condition, wall%friction, status)
    end subroutine validate_wall
+
+   !> mu >= 0, and given only with condition 'friction' (elsewhere it would be silently unused).
+   subroutine check_friction(where, condition, friction, status)
+      character(len=*), intent(in) :: where, condition
+      real(rp), intent(in) :: friction
+      type(status_t), intent(inout) :: status
+      if (.not. status%ok) return
+      call check_real(where, 'friction', friction, status, at_least=0.0_rp)
+      if (status%ok .and. friction > 0.0_rp .and. condition /= wall_friction) &
+         call status%fail(where//': variable friction = '//real_text(friction)//" is used only with condition = '"// &
+                          wall_friction//"', got condition = '"//trim(condition)//"'")
+   end subroutine check_friction
+
+   !> A structure: its name, condition and friction, the shape's parameters (shape_problem), a box by its
+   !> corners or by centre and size (not both), and the whole shape inside the scene box.
+   subroutine validate_structure(structure, s, grid, path, status)
+      type(structure_spec_t), intent(in) :: structure
+      integer, intent(in) :: s
+      type(grid_spec_t), intent(in) :: grid
+      character(len=*), intent(in) :: path
+      type(status_t), intent(inout) :: status
+      character(len=:), allocatable :: where, problem
+      type(shape_t) :: shape
+      real(rp) :: lower(3), upper(3), tolerance, top
+      integer :: k, dim, v
+      logical :: corners
+
+      dim = grid%dim
+      where = group_context(path, 'structure', s, name_detail(structure%name))
+      call check_name(where, 'name', structure%name, status)
+      if (.not. status%ok) return
+      if (all(structure%condition /= wall_condition_keywords)) then
+         call status%fail(where//': variable condition must be one of '//quoted_list(wall_condition_keywords)// &
+                          ", got '"//trim(structure%condition)//"'")
+         return
+      end if
+      call check_friction(where, structure%condition, structure%friction, status)
+      shape = structure%shape
+      do k = 1, dim
+         call check_real(where, 'centre('//int_text(k)//')', shape%centre(k), status)
+         call check_real(where, 'size('//int_text(k)//')', shape%size(k), status)
+         call check_real(where, 'axis('//int_text(k)//')', shape%axis(k), status)
+         call check_real(where, 'rotation_axis('//int_text(k)//')', shape%rotation_axis(k), status)
+      end do
+      call check_real(where, 'rotation', shape%rotation, status)
+      call check_real(where, 'radius', shape%radius, status)
+      call check_real(where, 'length', shape%length, status)
+      call check_real(where, 'z_range(1)', shape%z_range(1), status)
+      call check_real(where, 'z_range(2)', shape%z_range(2), status)
+      if (.not. status%ok) return
+      do v = 1, max_vertices
+         ! the slots hold x, y pairs; 'none' (no_vertex) marks the end of the list
+         if (all(is_none(shape%vertices(:, v)))) exit
+         do k = 1, 2
+            if (is_none(shape%vertices(k, v))) then
+               call status%fail(where//': variable vertices has an odd number of values ('//int_text(2 * v - 1)// &
+                                '): give x1, y1, x2, y2, ... in pairs')
+               return
+            end if
+            call check_real(where, 'vertices('//int_text(2 * (v - 1) + k)//')', shape%vertices(k, v), status)
+         end do
+         if (.not. status%ok) return
+      end do
+
+      ! a box by its corners: both, and instead of centre and size
+      corners = any(structure%lower(1:dim) < huge(1.0_rp)) .or. any(structure%upper(1:dim) < huge(1.0_rp))
+      if (corners) then
+         if (shape%kind /= shape_box) then
+            call status%fail(where//": variables lower and upper give a box's corners, but shape = '"// &
+                             trim(shape%kind)//"' (use them with shape = 'box')")
+            return
+         end if
+         if (any(abs(shape%size(1:dim)) > 0.0_rp) .or. any(abs(shape%centre(1:dim)) > 0.0_rp)) then
+            call status%fail(where//': variables lower and upper give the box, and so do centre and size: '// &
+                             'give one pair only')
+            return
+         end if
+         do k = 1, dim
+            call check_real(where, 'lower('//int_text(k)//')', structure%lower(k), status, less_than=huge(1.0_rp))
+            call check_real(where, 'upper('//int_text(k)//')', structure%upper(k), status, less_than=huge(1.0_rp))
+            if (status%ok .and. .not. structure%upper(k) > structure%lower(k)) &
+               call status%fail(where//': variable upper('//int_text(k)//') must be > lower('//int_text(k)//') = '// &
+                                real_text(structure%lower(k))//', got '//real_text(structure%upper(k)))
+            if (.not. status%ok) return
+         end do
+         shape = box_corners(shape, structure%lower, structure%upper, dim)
+      end if
+
+      problem = shape_problem(shape, dim)
+      if (len(problem) > 0) then
+         call status%fail(where//': variable '//problem)
+         return
+      end if
+      do k = 1, dim
+         ! huge: not given (the shape's centre)
+         call check_real(where, 'moment_point('//int_text(k)//')', structure%moment_point(k), status)
+      end do
+      if (.not. status%ok) return
+
+      ! the scene box is axis-aligned in the world frame, whatever the grid's rotation (as for &gauge)
+      call shape_bounds(shape, dim, lower, upper)
+      tolerance = inside_tolerance * grid%cell_size
+      do k = 1, dim
+         top = grid%origin(k) + grid%extent(k)
+         if (lower(k) < grid%origin(k) - tolerance .or. upper(k) > top + tolerance) then
+            call status%fail(where//': variables '//shape_variables(shape%kind, corners)//' put the structure '// &
+                             'outside the scene box of &grid: it spans '//axis_letter(k)//' = '//real_text(lower(k))// &
+                             ' .. '//real_text(upper(k))//', the box '//real_text(grid%origin(k))//' .. '//real_text(top))
+            return
+         end if
+      end do
+   end subroutine validate_structure
+
+   !> `shape` with the centre and size of the box lower..upper (its first dim components; rotation kept).
+   pure function box_corners(shape, lower, upper, dim) result(box)
+      type(shape_t), intent(in) :: shape
+      real(rp), intent(in) :: lower(3), upper(3)
+      integer, intent(in) :: dim
+      type(shape_t) :: box, corners
+      real(rp) :: lo(3), up(3)
+      lo = 0.0_rp
+      up = 0.0_rp
+      lo(1:dim) = lower(1:dim)
+      up(1:dim) = upper(1:dim)
+      corners = box_from_corners(lo, up)
+      box = shape
+      box%centre(1:dim) = corners%centre(1:dim)
+      box%size(1:dim) = corners%size(1:dim)
+   end function box_corners
+
+   !> The value that marks the end of a vertex list (a NaN is a value given, and reported as such).
+   elemental logical function is_none(value)
+      real(rp), intent(in) :: value
+      is_none = .false.
+      if (ieee_is_finite(value)) is_none = value >= no_vertex
+   end function is_none
+
+   !> The variables that place a shape of kind `kind`, for messages.
+   pure function shape_variables(kind, corners) result(names)
+      character(len=*), intent(in) :: kind
+      logical, intent(in) :: corners
+      character(len=:), allocatable :: names
+      select case (kind)
+      case (shape_box)
+         names = 'centre, size and rotation'
+         if (corners) names = 'lower, upper and rotation'
+      case (shape_circle, shape_sphere)
+         names = 'centre and radius'
+      case (shape_cylinder)
+         names = 'centre, axis, length and radius'
+      case (shape_polygon)
+         names = 'vertices'
+      case (shape_extruded_polygon)
+         names = 'vertices and z_range'
+      case default
+         names = 'shape'
+      end select
+   end function shape_variables
 
    subroutine validate_inlet(inlet, i, materials, grid, path, status)
       type(inlet_spec_t), intent(in) :: inlet
@@ -938,7 +1161,7 @@ contains
       character(len=:), allocatable :: owner
       integer :: n, k, side, i, j
 
-      allocate (names(6 + wall_count(scene) + inlet_count(scene) + body_count(scene)))
+      allocate (names(6 + wall_count(scene) + inlet_count(scene) + body_count(scene) + structure_count(scene)))
       n = 0
       do k = 1, 3
          do side = 1, 2
@@ -963,6 +1186,12 @@ contains
          n = n + 1
          call set_name(names(n), scene%bodies(i)%name, default_name('body', i), 'the '//ordinal(i)//' &body', &
                        group_context(path, 'body', i, "material '"//trim(scene%bodies(i)%material)//"'"), 'name')
+      end do
+      do i = 1, structure_count(scene)
+         n = n + 1
+         call set_name(names(n), scene%structures(i)%name, default_name('structure', i), &
+                       'the '//ordinal(i)//' &structure', &
+                       group_context(path, 'structure', i, name_detail(scene%structures(i)%name)), 'name')
       end do
 
       ! Two default names never clash, so every clash involves a given name: report it there (the later

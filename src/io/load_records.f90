@@ -1,5 +1,5 @@
 !> The time series a run writes for the loads question (docs/output.md, docs/loads.md):
-!>   loads.csv   force and moment the material exerts on every wall, box side and inlet (wall_loads)
+!>   loads.csv   force and moment the material exerts on every wall, box side, inlet and structure (wall_loads)
 !>   gauges.csv  the &gauge readings (fluid_gauges)
 !>   bodies.csv  centroid, velocity, rotation and resultant force of every solid body (body_motion)
 !> A file is written only if the scene has something for it. Rows come every `&run load_interval`
@@ -179,9 +179,9 @@ contains
       select case (f)
       case (file_loads)
          call file%write_row('# loads.csv: force <name>_f* and moment <name>_m* the material exerts on each wall, box '// &
-                             'side and inlet, world frame; each row is the mean over the interval since the previous '// &
-                             'row (impulse / interval); moments about each wall''s moment_point (default its point; '// &
-                             'box sides: the side''s lower corner)')
+                             'side, inlet and structure, world frame; each row is the mean over the interval since the '// &
+                             'previous row (impulse / interval); moments about each wall''s moment_point (default its '// &
+                             'point; box sides: the side''s lower corner; structures: the shape''s centre)')
          call file%write_row('# units: time s; _fx _fy _fz '//force//'; _mx _my _mz '//moment//per_depth)
       case (file_gauges)
          call file%write_row('# gauges.csv: readings of the &gauge sensors at the row''s time, world frame; '// &

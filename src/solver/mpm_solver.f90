@@ -16,7 +16,7 @@ module mpm_solver
                       MPI_INTEGER8
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use error_status, only: status_t
-   use scene_description, only: scene_t, run_control_t, wall_spec_t
+   use scene_description, only: scene_t, run_control_t, wall_spec_t, model_newtonian_fluid
    use domain_decomposition, only: domain_t, layout_dims, fit_box
    use load_balance, only: balanced_layout
    use particle_redistribution, only: redistribute_particles
@@ -32,7 +32,8 @@ module mpm_solver
    use stabilizer, only: stabilizer_slot_t, stage_context_t
    use stabilizer_factory, only: build_stabilizers
    use volume_correction, only: volume_corrector_t, max_shift_in_cells
-   use boundary_walls, only: wall_t, build_walls, set_wall_activity, apply_wall_constraints, keep_particles_inside
+   use boundary_walls, only: wall_t, build_walls, build_structures, set_wall_activity, apply_wall_constraints, &
+                             keep_particles_inside, first_particle_inside, box_side_walls, wall_distance
    use fluid_inflow, only: inlet_t, build_inlets
    use wall_loads, only: wall_loads_t
    use fluid_gauges, only: fluid_gauges_t
@@ -44,7 +45,7 @@ module mpm_solver
    use active_region, only: scene_extent, particle_extent, cells_of_extent, guard_cells, box_needs_change, target_box, &
                             slack_cells
    use status_broadcast, only: agree_on_status
-   use input_text, only: int_text
+   use input_text, only: int_text, real_text, group_context
    use phase_timers, only: phase_timers_t, phase_particles_to_grid, phase_grid_update, phase_walls, &
                            phase_stabilization, phase_grid_to_particles, phase_constitutive, phase_inflow, &
                            phase_halo, phase_migration, phase_sort, phase_time_step, phase_volume_correction, &
@@ -146,6 +147,9 @@ contains
       if (seed) call seed_bodies(scene, self%grid, self%domain, self%particles)
       call self%check_particle_memory(status)
       if (.not. status%ok) return
+      if (seed) call displace_fluid(self)
+      if (seed) call check_structures_clear(self, status)
+      if (.not. status%ok) return
       call update_cells(self%grid, self%particles)
       call sort_by_material_and_cell(self%grid, self%particles)
       call size_node_arrays(self)
@@ -176,10 +180,12 @@ contains
       call agree_on_status(status, self%domain%comm)
    end subroutine solver_check_particle_memory
 
-   !> The walls (with their local nodes) and the inlets (with their feeder walls) of the scene.
+   !> The walls (with their local nodes), the inlets (with their feeder walls) and the structures of the
+   !> scene, in the order of the entries of loads.csv.
    subroutine build_boundaries(self)
       type(solver_t), intent(inout) :: self
       type(wall_spec_t), allocatable :: no_walls(:)
+      integer :: entries
       if (allocated(self%scene%walls)) then
          call build_walls(self%scene%walls, self%scene%grid, self%grid, self%walls)
       else
@@ -187,7 +193,75 @@ contains
          call build_walls(no_walls, self%scene%grid, self%grid, self%walls)
       end if
       call build_inlets(self%scene, self%grid, body_particle_count(self%scene), self%inlets, self%walls)
+      if (.not. allocated(self%scene%structures)) return
+      ! loads.csv entries before the structures: the &wall groups, the box sides, the inlets
+      entries = size(box_side_walls(self%scene%grid)) + size(self%inlets)
+      if (allocated(self%scene%walls)) entries = entries + size(self%scene%walls)
+      call build_structures(self%scene%structures, self%grid, entries, self%walls)
    end subroutine build_boundaries
+
+   !> A structure displaces the fluid: the particles of fluid bodies seeded inside it (phi < 0) are not
+   !> kept, so that a structure can stand in water at rest [R]. Solid bodies are not cut (check_structures_clear
+   !> refuses them). Local: a particle's fate depends on its position only.
+   subroutine displace_fluid(self)
+      type(solver_t), intent(inout) :: self
+      integer :: w, first, p, kept
+      logical :: inside
+      if (.not. allocated(self%scene%structures)) return
+      first = size(self%walls) - size(self%scene%structures)
+      kept = 0
+      do p = 1, self%particles%count
+         inside = .false.
+         if (self%scene%materials(self%particles%material(p))%model == model_newtonian_fluid) then
+            do w = first + 1, size(self%walls)
+               if (wall_distance(self%walls(w), self%grid, self%particles%x(:, p)) < 0.0_rp) inside = .true.
+            end do
+         end if
+         if (inside) cycle
+         kept = kept + 1
+         if (kept < p) call self%particles%copy_particle(p, kept)
+      end do
+      self%particles%count = kept
+   end subroutine displace_fluid
+
+   !> Refuse a scene whose solid bodies start inside a structure: a seeded particle with phi < 0 (whatever the
+   !> body's shape). The message names the structure and the place of the lowest rank's first such
+   !> particle. Collective.
+   subroutine check_structures_clear(self, status)
+      type(solver_t), intent(in) :: self
+      type(status_t), intent(inout) :: status
+      integer :: w, s, p, first
+      real(rp) :: depth, x(3)
+      if (.not. allocated(self%scene%structures)) return
+      first = size(self%walls) - size(self%scene%structures)
+      do s = 1, size(self%scene%structures)
+         w = first + s
+         p = first_particle_inside(self%walls(w), self%grid, self%particles, depth)
+         if (p == 0) cycle
+         x = 0.0_rp
+         x(1:self%grid%dim) = self%grid%frame%world_point(self%particles%x(:, p))
+         call status%fail(group_context(self%scene%source_file, 'structure', s, "name '"// &
+                                        trim(self%scene%structures(s)%name)//"'")// &
+                          ": the structure overlaps a body at the start: a particle of material '"// &
+                          trim(self%scene%materials(self%particles%material(p))%name)//"' at "// &
+                          point_text(x(1:self%grid%dim))//' lies '//real_text(depth)// &
+                          ' m inside it (move the body or the structure)')
+         exit
+      end do
+      call agree_on_status(status, self%domain%comm)
+   end subroutine check_structures_clear
+
+   !> "(0.1, 0.25)"
+   function point_text(x) result(text)
+      real(rp), intent(in) :: x(:)
+      character(len=:), allocatable :: text
+      integer :: k
+      text = '('//real_text(x(1))
+      do k = 2, size(x)
+         text = text//', '//real_text(x(k))
+      end do
+      text = text//')'
+   end function point_text
 
    !> Solver arrays over the local nodes (the grid's own arrays are sized by grid%init).
    subroutine size_node_arrays(self)

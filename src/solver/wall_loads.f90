@@ -1,4 +1,4 @@
-!> Forces and moments the material exerts on the walls, box sides and inlets of a scene (loads.csv;
+!> Forces and moments the material exerts on the walls, box sides, inlets and structures of a scene (loads.csv;
 !> docs/loads.md, docs/theory.md section 3.2, algorithms.md section 9.1).
 !>
 !> Every step the walls record, per wall and rank, the momentum their constraints gave the material
@@ -19,7 +19,7 @@ module wall_loads
 
    type, public :: wall_loads_t
       integer :: dim = 2
-      character(len=name_len), allocatable :: names(:)   !< one entry per wall, box side and inlet
+      character(len=name_len), allocatable :: names(:)   !< one entry per wall, box side, inlet and structure
       real(rp), allocatable :: step_impulse(:, :)        !< (impulse_rows, wall) this rank, this step
       real(rp), allocatable :: impulse(:, :)             !< (impulse_rows, entry) this rank, since last row
       !> time of the last row of loads.csv, gauges.csv and bodies.csv: the start of the interval now
@@ -36,22 +36,28 @@ module wall_loads
 contains
 
    !> The entries of the scene in loads.csv order: the &wall groups, the &box_walls sides that are walls,
-   !> the &inlet groups (the order of the walls boundary_walls and fluid_inflow build, section 3).
+   !> the &inlet groups, the &structure groups (the order of the walls boundary_walls and fluid_inflow
+   !> build, section 3).
    subroutine loads_init(self, scene)
       class(wall_loads_t), intent(inout) :: self
       type(scene_t), intent(in) :: scene
       type(wall_spec_t), allocatable :: sides(:)
-      integer :: n_walls, n_inlets
+      integer :: n_walls, n_inlets, n_structures, before
       self%dim = scene%grid%dim
       sides = box_side_walls(scene%grid)
       n_walls = 0
       if (allocated(scene%walls)) n_walls = size(scene%walls)
       n_inlets = 0
       if (allocated(scene%inlets)) n_inlets = size(scene%inlets)
-      allocate (self%names(n_walls + size(sides) + n_inlets))
+      n_structures = 0
+      if (allocated(scene%structures)) n_structures = size(scene%structures)
+      allocate (self%names(n_walls + size(sides) + n_inlets + n_structures))
       if (n_walls > 0) self%names(1:n_walls) = scene%walls%name
       if (size(sides) > 0) self%names(n_walls + 1:n_walls + size(sides)) = sides%name
-      if (n_inlets > 0) self%names(n_walls + size(sides) + 1:) = scene%inlets%name
+      before = n_walls + size(sides)
+      if (n_inlets > 0) self%names(before + 1:before + n_inlets) = scene%inlets%name
+      before = before + n_inlets
+      if (n_structures > 0) self%names(before + 1:) = scene%structures%name
       allocate (self%impulse(impulse_rows, size(self%names)))
       self%impulse = 0.0_rp
    end subroutine loads_init

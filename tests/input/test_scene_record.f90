@@ -33,7 +33,10 @@ contains
          "&body name = 'debris', material = 'block', lower = 1.5, 0.0, upper = 1.7, 0.2 /", &
          "&wall name = 'pier', point = 2.0, 0.5, normal = -1.0, 0.0, moment_point = 2.0, 0.0 /", &
          "&inlet material = 'water', point = 0.0, 1.2, direction = 2.0, 0.0, height = 0.3, velocity = 1.0 /", &
-         "&gauge name = 'p_pier', kind = 'pressure', point = 2.0, 0.3 /"]
+         "&gauge name = 'p_pier', kind = 'pressure', point = 2.0, 0.3 /", &
+         "&structure name = 'reef', shape = 'polygon', vertices = 2.2, 0.0, 2.8, 0.0, 2.5, 0.4,", &
+         "           condition = 'friction', friction = 0.3 /", &
+         "&structure lower = 2.0, 1.0, upper = 2.4, 1.2, rotation = 10.0 /"]
       type(scene_t) :: scene, again
       type(status_t) :: status
       type(namelist_text_t), allocatable :: groups(:)
@@ -67,9 +70,12 @@ contains
       call assertEqual(0, index(text, ' = '//nl), 'every variable has a value')
       call assertTrue(index(text, "   direction = 1.0, 0.0, 0.0"//nl) > 0, 'resolved values: unit inlet direction')
       call assertTrue(index(text, "   name = 'body_1'"//nl) > 0, 'resolved values: default body name')
+      call assertTrue(index(text, "   vertices = 2.2, 0.0, 2.8, 0.0, 2.5, 0.4"//nl) > 0, 'the vertices given, as a list')
+      call assertTrue(index(text, "   name = 'structure_2'"//nl) > 0, 'resolved values: default structure name')
+      call assertTrue(index(text, "   lower = 2.0, 1.0") == 0, 'a box by its corners is resolved into centre and size')
 
       groups = scene_namelist_groups(scene)
-      call assertEqual(4 + 2 + 2 + 1 + 1 + 1, size(groups), 'singleton groups once, repeated ones per entry')
+      call assertEqual(4 + 2 + 2 + 1 + 1 + 1 + 2, size(groups), 'singleton groups once, repeated ones per entry')
       do g = 1, size(known_groups)
          names = group_variables(trim(known_groups(g)))
          do i = 1, size(groups)
