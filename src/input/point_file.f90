@@ -64,8 +64,8 @@ contains
       if (allocated(scene%body_points)) deallocate (scene%body_points)
       allocate (scene%body_points(size(scene%bodies)))
       tolerance = 1.0e-9_rp * scene%grid%cell_size
-      box_lower = scene%grid%origin - tolerance
-      box_upper = scene%grid%origin + scene%grid%extent + tolerance
+      box_lower = scene%grid%origin
+      box_upper = scene%grid%origin + scene%grid%extent
       do b = 1, size(scene%bodies)
          associate (body => scene%bodies(b), points => scene%body_points(b))
             if (.not. has_points_file(body)) cycle
@@ -80,8 +80,8 @@ contains
                call status%fail(where//': '//absolute//': the path is longer than '//int_text(path_len)//' characters')
                return
             end if
-            call read_point_file(absolute, dim, box_lower(1:dim), box_upper(1:dim), points%position, points%volume, &
-                                 status)
+            call read_point_file(absolute, dim, box_lower(1:dim), box_upper(1:dim), tolerance, points%position, &
+                                 points%volume, status)
             if (.not. status%ok) then
                status%message = where//': '//trim(status%message)
                return
@@ -134,11 +134,11 @@ contains
    end function absolute_path
 
    !> Read the points of `path` (CSV or HDF5, by its ending) in a `dim`-dimensional scene: positions
-   !> (dim, n) and volumes (n), every point inside lower..upper. Messages start with the path.
-   subroutine read_point_file(path, dim, lower, upper, position, volume, status)
+   !> (dim, n) and volumes (n), every point inside lower..upper (to `tolerance`). Messages start with the path.
+   subroutine read_point_file(path, dim, lower, upper, tolerance, position, volume, status)
       character(len=*), intent(in) :: path
       integer, intent(in) :: dim
-      real(rp), intent(in) :: lower(dim), upper(dim)
+      real(rp), intent(in) :: lower(dim), upper(dim), tolerance
       real(rp), allocatable, intent(out) :: position(:, :), volume(:)
       type(status_t), intent(inout) :: status
       character(len=:), allocatable :: ending
@@ -149,9 +149,9 @@ contains
       if (dot > index(path, '/', back=.true.)) ending = lower_case(path(dot + 1:))
       select case (ending)
       case ('csv')
-         call read_csv_points(path, dim, lower, upper, position, volume, status)
+         call read_csv_points(path, dim, lower, upper, tolerance, position, volume, status)
       case ('h5', 'hdf5')
-         call read_hdf5_points(path, dim, lower, upper, position, volume, status)
+         call read_hdf5_points(path, dim, lower, upper, tolerance, position, volume, status)
       case default
          call status%fail(path//": the name must end in .csv (a table) or .h5 / .hdf5 (datasets 'position' and "// &
                           "'volume')")
@@ -159,10 +159,10 @@ contains
    end subroutine read_point_file
 
    !> A table of points: header line, then x, y[, z], volume per line (docs/input.md).
-   subroutine read_csv_points(path, dim, lower, upper, position, volume, status)
+   subroutine read_csv_points(path, dim, lower, upper, tolerance, position, volume, status)
       character(len=*), intent(in) :: path
       integer, intent(in) :: dim
-      real(rp), intent(in) :: lower(dim), upper(dim)
+      real(rp), intent(in) :: lower(dim), upper(dim), tolerance
       real(rp), allocatable, intent(out) :: position(:, :), volume(:)
       type(status_t), intent(inout) :: status
       character(len=*), parameter :: axis_names(3) = ['x', 'y', 'z']
@@ -229,7 +229,7 @@ contains
             end if
          end do
          if (.not. status%ok) exit
-         call check_point(where, values(1:dim), values(dim + 1), lower, upper, status)
+         call check_point(where, values(1:dim), values(dim + 1), lower, upper, tolerance, status)
          if (.not. status%ok) exit
          if (n == size(grown, 2)) call grow(grown)
          n = n + 1
@@ -270,9 +270,9 @@ contains
    end subroutine grow
 
    !> A point must be finite, of positive volume and inside the scene box lower..upper.
-   subroutine check_point(where, x, volume, lower, upper, status)
+   subroutine check_point(where, x, volume, lower, upper, tolerance, status)
       character(len=*), intent(in) :: where
-      real(rp), intent(in) :: x(:), volume, lower(:), upper(:)
+      real(rp), intent(in) :: x(:), volume, lower(:), upper(:), tolerance
       type(status_t), intent(inout) :: status
       character(len=*), parameter :: axis_names(3) = ['x', 'y', 'z']
       integer :: k
@@ -281,7 +281,7 @@ contains
          return
       end if
       do k = 1, size(x)
-         if (x(k) < lower(k) .or. x(k) > upper(k)) then
+         if (x(k) < lower(k) - tolerance .or. x(k) > upper(k) + tolerance) then
             call status%fail(where//': the point lies outside the scene box of &grid: '//axis_names(k)//' = '// &
                              real_text(x(k))//', the box spans '//real_text(lower(k))//' .. '//real_text(upper(k)))
             return
@@ -364,10 +364,10 @@ contains
    end function read_number
 
    !> Datasets `position` and `volume` of an HDF5 file (at the root or in group `particles`).
-   subroutine read_hdf5_points(path, dim, lower, upper, position, volume, status)
+   subroutine read_hdf5_points(path, dim, lower, upper, tolerance, position, volume, status)
       character(len=*), intent(in) :: path
       integer, intent(in) :: dim
-      real(rp), intent(in) :: lower(dim), upper(dim)
+      real(rp), intent(in) :: lower(dim), upper(dim), tolerance
       real(rp), allocatable, intent(out) :: position(:, :), volume(:)
       type(status_t), intent(inout) :: status
       integer(hid_t) :: file
@@ -432,7 +432,7 @@ contains
             return
          end if
          call check_point(path//': point '//int_text(p - 1)//' (0-based)', stored(1:dim, p), flat(1, p), lower, upper, &
-                          status)
+                          tolerance, status)
          if (.not. status%ok) return
       end do
       deallocate (position, volume)
@@ -470,12 +470,12 @@ contains
       if (rank < 1 .or. rank > 2) then
          call status%fail(path//': dataset '//name//' must have 1 or 2 dimensions, has '//int_text(rank))
       else
+         ! the Fortran interface gives the dimensions fastest first: h5py's (n, 2) is (2, n) here
          call h5sget_simple_extent_dims_f(space, found(1:rank), maxdims(1:rank), error)
-         ! HDF5 lists the dimensions slowest first; Fortran sees them reversed
          if (rank == 1) then
             dims = [1_hsize_t, found(1)]
          else
-            dims = [found(2), found(1)]
+            dims = found
          end if
          deallocate (values)
          allocate (values(dims(1), dims(2)))
