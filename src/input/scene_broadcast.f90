@@ -1,6 +1,7 @@
 !> Copy a scene from the rank that read the file to every rank.
 module scene_broadcast
-   use mpi_f08, only: MPI_Comm, MPI_Bcast, MPI_Comm_rank, MPI_CHARACTER, MPI_INTEGER
+   use mpi_f08, only: MPI_Comm, MPI_Bcast, MPI_Comm_rank, MPI_CHARACTER, MPI_INTEGER, MPI_DOUBLE_PRECISION, &
+                      MPI_LOGICAL
    use scene_description, only: scene_t
    implicit none
    private
@@ -69,6 +70,7 @@ contains
       call MPI_Bcast(n, 1, MPI_INTEGER, root, comm)
       if (rank /= root) call resize(bytes, n)
       call MPI_Bcast(bytes, n, MPI_CHARACTER, root, comm)
+      call broadcast_body_points(scene, counts(2), comm, root, rank)
       if (rank == root) return
 
       at = 1
@@ -101,6 +103,39 @@ contains
          at = at + length
       end function next_bytes
    end subroutine broadcast_scene
+
+   !> The points of the bodies read from files (scene%body_points, allocatable arrays): per body the
+   !> count (-1: none), then positions and volumes.
+   subroutine broadcast_body_points(scene, bodies, comm, root, rank)
+      type(scene_t), intent(inout) :: scene
+      integer, intent(in) :: bodies, root, rank
+      type(MPI_Comm), intent(in) :: comm
+      integer :: b, shape(3)
+      logical :: has_points
+      if (bodies < 0) return
+      has_points = allocated(scene%body_points)
+      call MPI_Bcast(has_points, 1, MPI_LOGICAL, root, comm)
+      if (.not. has_points) then
+         if (allocated(scene%body_points)) deallocate (scene%body_points)
+         return
+      end if
+      if (rank /= root) then
+         if (allocated(scene%body_points)) deallocate (scene%body_points)
+         allocate (scene%body_points(bodies))
+      end if
+      do b = 1, bodies
+         associate (points => scene%body_points(b))
+            shape = -1
+            if (rank == root .and. allocated(points%position)) shape(1:2) = [size(points%position, 1), &
+                                                                             size(points%position, 2)]
+            call MPI_Bcast(shape, 2, MPI_INTEGER, root, comm)
+            if (shape(1) < 0) cycle
+            if (rank /= root) allocate (points%position(shape(1), shape(2)), points%volume(shape(2)))
+            call MPI_Bcast(points%position, size(points%position), MPI_DOUBLE_PRECISION, root, comm)
+            call MPI_Bcast(points%volume, size(points%volume), MPI_DOUBLE_PRECISION, root, comm)
+         end associate
+      end do
+   end subroutine broadcast_body_points
 
    !> Allocate `bytes` with `n` elements (assigning to an unallocated array first makes gfortran 12
    !> warn falsely about uninitialised bounds).

@@ -146,18 +146,33 @@ module scene_description
       real(rp) :: eos_relaxation_rate = 0.01_rp    !< eos_relaxation: fraction of p - p_EOS(rho) removed per step
    end type material_spec_t
 
-   !> `&body`: a rectangle (2-D) or box (3-D) of one material filled with particles.
+   !> `&body`: a solid shape of one material filled with particles (docs/input.md): a box (`lower`/`upper`,
+   !> or `centre`/`size` in `shape`), a circle, polygon, sphere, cylinder or extruded polygon (`shape`), or
+   !> the particles of a file of points (`points_file`). Every value is kept as the scene gives it (the
+   !> scene record writes it back); body_lattice derives the lattice and bounds.
    type, public :: body_spec_t
       character(len=name_len) :: name = ''    !< name in bodies.csv; resolved default 'body_<k>'
       character(len=name_len) :: material = ''
       integer :: material_index = 0           !< derived: position in scene%materials
-      real(rp) :: lower(3) = 0.0_rp           !< lower corner [m]
-      real(rp) :: upper(3) = 0.0_rp           !< upper corner [m]
+      real(rp) :: lower(3) = 0.0_rp           !< box: lower corner [m] (lower = upper: not given)
+      real(rp) :: upper(3) = 0.0_rp           !< box: upper corner [m]
+      !> shape%kind and, except lower/upper, the shape's variables as given (shape_geometry)
+      type(shape_t) :: shape
+      !> file of points (CSV or HDF5) the body's particles are read from; resolved to an absolute path
+      character(len=path_len) :: points_file = ''
+      !> checksum of the points read from points_file (16 hex digits); given: must match the file
+      character(len=16) :: points_checksum = ''
       integer :: particles_per_cell = 2       !< particles per cell per direction
       real(rp) :: velocity(3) = 0.0_rp        !< initial velocity [m/s]
       logical :: hydrostatic = .false.        !< start from the hydrostatic stress of a fluid at rest
       real(rp) :: free_surface_level = 0.0_rp !< height of the free surface along -gravity [m]
    end type body_spec_t
+
+   !> The points of a `&body points_file` (empty for the other bodies): world positions and volumes.
+   type, public :: body_points_t
+      real(rp), allocatable :: position(:, :)  !< (dim, n) [m]
+      real(rp), allocatable :: volume(:)       !< (n) [m^3, m^2 in 2-D]
+   end type body_points_t
 
    !> Gauge kinds (`&gauge kind=`).
    character(len=*), parameter, public :: gauge_pressure = 'pressure'
@@ -190,6 +205,8 @@ module scene_description
       real(rp) :: gravity(3) = 0.0_rp         !< `&gravity acceleration=` [m/s^2]
       type(material_spec_t), allocatable :: materials(:)
       type(body_spec_t), allocatable :: bodies(:)
+      !> per body, the points of its points_file (read by rank 0, broadcast with the scene)
+      type(body_points_t), allocatable :: body_points(:)
       type(wall_spec_t), allocatable :: walls(:)      !< `&wall` groups (the `&box_walls` sides are in grid)
       type(structure_spec_t), allocatable :: structures(:)   !< `&structure` groups
       type(inlet_spec_t), allocatable :: inlets(:)

@@ -21,6 +21,8 @@ module scene_reader
    use scene_broadcast, only: broadcast_scene
    use status_broadcast, only: broadcast_status
    use input_text, only: lower_case, upper_case, int_text, ordinal, group_context, canonical_keyword
+   use shape_geometry, only: max_vertices
+   use point_file, only: load_body_points
    implicit none
    private
 
@@ -56,7 +58,7 @@ module scene_reader
    type :: variable_info_t
       character(len=9) :: group
       character(len=26) :: name
-      character(len=7) :: kind          !< real, real3, reals, integer, logical, string or string2 (two strings)
+      character(len=7) :: kind          !< real, real3, reals (a list), integer, logical, string or string2 (two strings)
       logical :: required
    end type variable_info_t
 
@@ -121,8 +123,20 @@ module scene_reader
       variable_info_t('material', 'eos_relaxation_rate', 'real', .false.), &
       variable_info_t('body', 'name', 'string', .false.), &
       variable_info_t('body', 'material', 'string', .true.), &
-      variable_info_t('body', 'lower', 'real3', .true.), &
-      variable_info_t('body', 'upper', 'real3', .true.), &
+      variable_info_t('body', 'shape', 'string', .false.), &
+      variable_info_t('body', 'lower', 'real3', .false.), &
+      variable_info_t('body', 'upper', 'real3', .false.), &
+      variable_info_t('body', 'centre', 'real3', .false.), &
+      variable_info_t('body', 'size', 'real3', .false.), &
+      variable_info_t('body', 'rotation', 'real', .false.), &
+      variable_info_t('body', 'rotation_axis', 'real3', .false.), &
+      variable_info_t('body', 'radius', 'real', .false.), &
+      variable_info_t('body', 'axis', 'real3', .false.), &
+      variable_info_t('body', 'length', 'real', .false.), &
+      variable_info_t('body', 'vertices', 'reals', .false.), &
+      variable_info_t('body', 'z_range', 'reals', .false.), &
+      variable_info_t('body', 'points_file', 'string', .false.), &
+      variable_info_t('body', 'points_checksum', 'string', .false.), &
       variable_info_t('body', 'particles_per_cell', 'integer', .false.), &
       variable_info_t('body', 'velocity', 'real3', .false.), &
       variable_info_t('body', 'hydrostatic', 'logical', .false.), &
@@ -211,6 +225,8 @@ contains
             end do
          end if
          if (status%ok) call validate_scene(scene, label, status)
+         ! the points of `&body points_file` (checked like the scene's values, before any output)
+         if (status%ok) call load_body_points(scene, label, status)
          if (status%ok) call resolve_scene(scene)
          ! before any particle is made: a scene too large for the machine is refused, not run out of memory
          if (status%ok) call check_scene_memory(scene, label, ranks, budget, status)
@@ -1053,16 +1069,31 @@ contains
       integer, intent(out) :: ios
       character(len=*), intent(inout) :: message
       character(len=*), intent(in) :: text
-      character(len=text_len) :: name, material
-      real(rp) :: lower(3), upper(3), velocity(3), free_surface_level
+      character(len=text_len) :: name, material, shape, points_file, points_checksum
+      real(rp) :: lower(3), upper(3), velocity(3), free_surface_level, centre(3), size(3), rotation, &
+                  rotation_axis(3), radius, axis(3), length, vertices(2 * max_vertices), z_range(2)
       integer :: particles_per_cell
       logical :: hydrostatic
-      namelist /body/ name, material, lower, upper, particles_per_cell, velocity, hydrostatic, free_surface_level
+      namelist /body/ name, material, shape, lower, upper, centre, size, rotation, rotation_axis, radius, axis, &
+         length, vertices, z_range, points_file, points_checksum, particles_per_cell, velocity, hydrostatic, &
+         free_surface_level
 
       name = spec%name
       material = spec%material
+      shape = spec%shape%kind
       lower = spec%lower
       upper = spec%upper
+      centre = spec%shape%centre
+      size = spec%shape%size
+      rotation = spec%shape%rotation
+      rotation_axis = spec%shape%rotation_axis
+      radius = spec%shape%radius
+      axis = spec%shape%axis
+      length = spec%shape%length
+      vertices = reshape(spec%shape%vertices, [2 * max_vertices])
+      z_range = spec%shape%z_range
+      points_file = spec%points_file
+      points_checksum = spec%points_checksum
       particles_per_cell = spec%particles_per_cell
       velocity = spec%velocity
       hydrostatic = spec%hydrostatic
@@ -1070,9 +1101,21 @@ contains
       read (text, nml=body, iostat=ios, iomsg=message)
       call take_text('name', name, spec%name, ios, message)
       call take_text('material', material, spec%material, ios, message)
+      call take_text('shape', shape, spec%shape%kind, ios, message, fold='lower')
+      call take_text('points_file', points_file, spec%points_file, ios, message)
+      call take_text('points_checksum', points_checksum, spec%points_checksum, ios, message, fold='lower')
       if (ios /= 0) return
       spec%lower = lower
       spec%upper = upper
+      spec%shape%centre = centre
+      spec%shape%size = size
+      spec%shape%rotation = rotation
+      spec%shape%rotation_axis = rotation_axis
+      spec%shape%radius = radius
+      spec%shape%axis = axis
+      spec%shape%length = length
+      spec%shape%vertices = reshape(vertices, [2, max_vertices])
+      spec%shape%z_range = z_range
       spec%particles_per_cell = particles_per_cell
       spec%velocity = velocity
       spec%hydrostatic = hydrostatic

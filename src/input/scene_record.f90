@@ -13,6 +13,7 @@ module scene_record
    use shape_geometry, only: no_vertex
    use scene_reader, only: known_groups, group_variables, entry_count
    use input_text, only: int_text, real_text
+   use shape_geometry, only: no_vertex
    implicit none
    private
 
@@ -271,10 +272,34 @@ contains
             text = quoted(body%name)
          case ('material')
             text = quoted(body%material)
+         case ('shape')
+            text = quoted(body%shape%kind)
          case ('lower')
             text = reals(body%lower)
          case ('upper')
             text = reals(body%upper)
+         case ('centre')
+            text = reals(body%shape%centre)
+         case ('size')
+            text = reals(body%shape%size)
+         case ('rotation')
+            text = real_text(body%shape%rotation)
+         case ('rotation_axis')
+            text = reals(body%shape%rotation_axis)
+         case ('radius')
+            text = real_text(body%shape%radius)
+         case ('axis')
+            text = reals(body%shape%axis)
+         case ('length')
+            text = real_text(body%shape%length)
+         case ('vertices')
+            text = vertex_list(body%shape%vertices)
+         case ('z_range')
+            text = reals(body%shape%z_range)
+         case ('points_file')
+            text = quoted(body%points_file)
+         case ('points_checksum')
+            text = quoted(body%points_checksum)
          case ('particles_per_cell')
             text = int_text(body%particles_per_cell)
          case ('velocity')
@@ -475,6 +500,26 @@ contains
       text = merge('.true. ', '.false.', value)
       text = trim(text)
    end function logical_text
+
+   !> The vertices as given, "x1, y1, x2, y2, ..." up to the first empty slot; none: a namelist null
+   !> value "," (the variable keeps its default, no vertex).
+   function vertex_list(vertices) result(text)
+      real(rp), intent(in) :: vertices(:, :)
+      character(len=:), allocatable :: text
+      real(rp), allocatable :: flat(:)
+      integer :: n
+      flat = reshape(vertices, [size(vertices)])
+      n = 0
+      do while (n < size(flat))
+         if (flat(n + 1) >= no_vertex) exit
+         n = n + 1
+      end do
+      if (n == 0) then
+         text = ','
+      else
+         text = reals(flat(1:n))
+      end if
+   end function vertex_list
 
    !> "1.0, -9.81, 0.0"
    function reals(values) result(text)

@@ -12,6 +12,7 @@
 module active_region
    use kinds, only: rp
    use scene_description, only: scene_t, opening_far_end
+   use body_lattice, only: body_bounds
    use world_frame, only: frame_t
    use particle_set, only: particle_set_t
    implicit none
@@ -26,7 +27,7 @@ module active_region
 contains
 
    !> Grid-frame extent lo..hi of what the scene will put into the grid from `time` on: with
-   !> `bodies`, the boxes of the bodies (their corners mapped into the grid frame), and the openings of
+   !> `bodies`, the bounding boxes of the bodies (body_lattice; their corners mapped into the grid frame), and the openings of
    !> the inlets that have not closed, each with one cell downstream where its new layers appear
    !> (fluid_inflow places them within v0 dt + Dp/2 of the opening). With `lead`, only the inlets that
    !> open before time + lead: an inlet that opens later costs no grid until then (the check after every
@@ -39,7 +40,7 @@ contains
       real(rp), intent(out) :: lo(3), hi(3)
       real(rp), intent(in), optional :: lead
       real(rp), allocatable :: points(:, :)        ! world points to cover (3, n)
-      real(rp) :: far_end(3), shift(3), g(3)
+      real(rp) :: far_end(3), shift(3), g(3), body_lower(3), body_upper(3)
       integer :: dim, b, i, corner, n
 
       dim = scene%grid%dim
@@ -50,10 +51,10 @@ contains
       n = 0
       if (bodies .and. allocated(scene%bodies)) then
          do b = 1, size(scene%bodies)
+            call body_bounds(scene, b, body_lower, body_upper)
             do corner = 0, 2**dim - 1
                n = n + 1
-               points(:, n) = merge(scene%bodies(b)%upper, scene%bodies(b)%lower, &
-                                    [btest(corner, 0), btest(corner, 1), btest(corner, 2)])
+               points(:, n) = merge(body_upper, body_lower, [btest(corner, 0), btest(corner, 1), btest(corner, 2)])
             end do
          end do
       end if

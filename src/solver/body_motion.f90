@@ -2,8 +2,9 @@
 !> docs/theory.md section 3.2).
 !>
 !> A body is the set of particles seeded for one `&body` of a solid material: its particles carry ids
-!> offset_b + lattice index (particle_seeding), so every particle knows its body and its reference
-!> position X in the seeded lattice, wherever it is and on whichever rank. Over a body's particles
+!> offset_b + lattice index, or + row of its points file (particle_seeding, body_lattice), so every
+!> particle knows its body and its reference position X (its lattice point, or its point in the file),
+!> wherever it is and on whichever rank. Over a body's particles
 !>   centroid    x_c = sum m x / M,   velocity v_c = P / M,   P = sum m v
 !>   rotation    the rotation R closest to the deformation of the lattice: the polar factor of
 !>               A = sum m (x - x_c)(X - X_c)^T  (2-D: theta = atan2(A21 - A12, A11 + A22), continued
@@ -19,21 +20,21 @@ module body_motion
    use scene_description, only: scene_t
    use material_model, only: material_slot_t
    use particle_set, only: particle_set_t
-   use particle_seeding, only: lattice_counts
+   use body_lattice, only: body_lattice_t, body_lattice_of, lattice_point, has_points_file, body_id_count, body_bounds
    use world_frame, only: frame_t
    implicit none
    private
 
    real(rp), parameter :: pi = acos(-1.0_rp)
 
-   !> One solid body: where its ids lie and how its lattice maps an id to a reference position.
+   !> One solid body: where its ids lie and how an id maps to a reference position.
    type :: tracked_body_t
       character(len=name_len) :: name = ''
       integer :: material = 0
       integer(i8) :: first_id = 0, id_count = 0
-      integer :: n(3) = 1                       !< lattice counts
-      real(rp) :: lower(3) = 0.0_rp             !< world lower corner of the lattice
-      real(rp) :: spacing(3) = 1.0_rp           !< world lattice spacing
+      type(body_lattice_t) :: lattice           !< a body of a shape: id - first_id is its lattice index
+      !> a body of a points file: the grid-frame reference position of each id (dim, id_count)
+      real(rp), allocatable :: reference(:, :)
       real(rp) :: centre(3) = 0.0_rp            !< grid-frame point sums are taken about (conditioning)
    end type tracked_body_t
 
@@ -61,8 +62,6 @@ module body_motion
       procedure :: count => bodies_count
    end type body_motion_t
 
-   public :: reference_position
-
 contains
 
    !> The solid bodies of the scene, in &body order (fluid bodies are not tracked).
@@ -72,8 +71,9 @@ contains
       type(material_slot_t), intent(in) :: materials(:)
       type(frame_t), intent(in) :: frame
       real(rp), intent(in) :: gravity(3)
-      integer :: b, dim
+      integer :: b, dim, p
       integer(i8) :: offset
+      real(rp) :: lo(3), hi(3)
       type(tracked_body_t) :: body
 
       dim = scene%grid%dim
@@ -83,18 +83,24 @@ contains
       offset = 0
       do b = 1, size(scene%bodies)
          associate (spec => scene%bodies(b))
-            body%n = lattice_counts(spec, dim, scene%grid%cell_size)
             body%first_id = offset
-            body%id_count = product(int(body%n, i8))
+            body%id_count = body_id_count(scene, b)
             offset = offset + body%id_count
             if (materials(spec%material_index)%model%is_fluid) cycle
             body%name = spec%name
             body%material = spec%material_index
-            body%lower = spec%lower
-            body%spacing = 1.0_rp
-            body%spacing(1:dim) = (spec%upper(1:dim) - spec%lower(1:dim)) / body%n(1:dim)
+            if (allocated(body%reference)) deallocate (body%reference)
+            if (has_points_file(spec)) then
+               allocate (body%reference(dim, body%id_count))
+               do p = 1, int(body%id_count)
+                  body%reference(:, p) = frame%grid_point(scene%body_points(b)%position(:, p))
+               end do
+            else
+               body%lattice = body_lattice_of(spec, scene%grid)
+            end if
+            call body_bounds(scene, b, lo, hi)
             body%centre = 0.0_rp
-            body%centre(1:dim) = frame%grid_point(0.5_rp * (spec%lower(1:dim) + spec%upper(1:dim)))
+            body%centre(1:dim) = frame%grid_point(0.5_rp * (lo(1:dim) + hi(1:dim)))
             self%bodies = [self%bodies, body]
          end associate
       end do
@@ -109,18 +115,20 @@ contains
       if (allocated(self%bodies)) bodies_count = size(self%bodies)
    end function bodies_count
 
-   !> World-frame reference position of the particle with lattice index k (0-based) in a body with
-   !> lattice counts n, lower corner and spacing: the position seed_bodies gave it.
-   pure function reference_position(k, n, lower, spacing, dim) result(x)
+   !> Grid-frame reference position of the particle with index k (0-based) in the body: where
+   !> seed_bodies put it.
+   pure function reference_position(body, k, frame, dim) result(x)
+      type(tracked_body_t), intent(in) :: body
       integer(i8), intent(in) :: k
-      integer, intent(in) :: n(3), dim
-      real(rp), intent(in) :: lower(3), spacing(3)
-      real(rp) :: x(dim)
-      integer(i8) :: ijk(3)
-      ijk(1) = mod(k, int(n(1), i8))
-      ijk(2) = mod(k / n(1), int(n(2), i8))
-      ijk(3) = k / (int(n(1), i8) * n(2))
-      x = lower(1:dim) + (real(ijk(1:dim), rp) + 0.5_rp) * spacing(1:dim)
+      type(frame_t), intent(in) :: frame
+      integer, intent(in) :: dim
+      real(rp) :: x(dim), world(3)
+      if (allocated(body%reference)) then
+         x = body%reference(:, k + 1)
+      else
+         world = lattice_point(body%lattice, k)
+         x = frame%grid_point(world(1:dim))
+      end if
    end function reference_position
 
    !> The bodies' state now, from all ranks' particles. Collective (one reduction), also with no bodies
@@ -149,7 +157,7 @@ contains
             do p = particles%material_first(body%material), particles%material_last(body%material)
                k = particles%id(p) - body%first_id
                if (k < 0 .or. k >= body%id_count) cycle
-               xr = frame%grid_point(reference_position(k, body%n, body%lower, body%spacing, d)) - body%centre(1:d)
+               xr = reference_position(body, k, frame, d) - body%centre(1:d)
                dx = particles%x(:, p) - body%centre(1:d)
                associate (m => particles%mass(p), s => sums(:, b))
                   s(1) = s(1) + m

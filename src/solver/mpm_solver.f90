@@ -23,7 +23,8 @@ module mpm_solver
    use background_grid, only: grid_t, row_mass
    use node_halo, only: sum_shared_nodes
    use particle_set, only: particle_set_t
-   use particle_seeding, only: seed_bodies, body_particle_count
+   use particle_seeding, only: seed_bodies
+   use body_lattice, only: scene_id_count
    use particle_sorting, only: sort_by_material_and_cell, update_cells, set_material_ranges
    use particle_migration, only: migrate_particles
    use material_model, only: material_slot_t
@@ -192,7 +193,8 @@ contains
          allocate (no_walls(0))
          call build_walls(no_walls, self%scene%grid, self%grid, self%walls)
       end if
-      call build_inlets(self%scene, self%grid, body_particle_count(self%scene), self%inlets, self%walls)
+      ! inlet ids start after every id of the bodies (their whole lattices, not just the particles kept)
+      call build_inlets(self%scene, self%grid, scene_id_count(self%scene), self%inlets, self%walls)
       if (.not. allocated(self%scene%structures)) return
       ! loads.csv entries before the structures: the &wall groups, the box sides, the inlets
       entries = size(box_side_walls(self%scene%grid)) + size(self%inlets)

@@ -31,6 +31,8 @@ contains
          "&material name = 'block', model = 'linear_elastic', density = 500.0, youngs_modulus = 1.0e6 /", &
          "&body material = 'water', lower = 0.0, 0.0, upper = 1.0, 1.0, hydrostatic = T /", &
          "&body name = 'debris', material = 'block', lower = 1.5, 0.0, upper = 1.7, 0.2 /", &
+         "&body name = 'log', material = 'block', shape = 'polygon', vertices = 2.0, 1.0, 2.4, 1.0, 2.2, 1.3 /", &
+         "&body name = 'drum', material = 'block', shape = 'circle', centre = 2.5, 0.5, radius = 0.2 /", &
          "&wall name = 'pier', point = 2.0, 0.5, normal = -1.0, 0.0, moment_point = 2.0, 0.0 /", &
          "&inlet material = 'water', point = 0.0, 1.2, direction = 2.0, 0.0, height = 0.3, velocity = 1.0 /", &
          "&gauge name = 'p_pier', kind = 'pressure', point = 2.0, 0.3 /", &
@@ -75,7 +77,9 @@ contains
       call assertTrue(index(text, "   lower = 2.0, 1.0") == 0, 'a box by its corners is resolved into centre and size')
 
       groups = scene_namelist_groups(scene)
-      call assertEqual(4 + 2 + 2 + 1 + 1 + 1 + 2, size(groups), 'singleton groups once, repeated ones per entry')
+      call assertEqual(4 + 2 + 4 + 1 + 1 + 1 + 2, size(groups), 'singleton groups once, repeated ones per entry')
+      call assertTrue(index(text, "   vertices = 2.0, 1.0, 2.4, 1.0, 2.2, 1.3"//nl) > 0, 'vertices as given')
+      call assertTrue(index(text, "   vertices = ,"//nl) > 0, 'no vertices: a null value')
       do g = 1, size(known_groups)
          names = group_variables(trim(known_groups(g)))
          do i = 1, size(groups)
