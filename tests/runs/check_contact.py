@@ -28,6 +28,15 @@
      at v0 / (mu g) within 3 %; with mu = 0 it keeps its speed (deceleration below 3 % of 0.2 g); with one
      velocity field it sticks to the base (its centroid stays within a cell of where it started).
 
+  7. a body against a structure (scenes/contact/block_on_structure.nml): a block sliding on a box structure
+     whose own condition is slip, with mu = 0.2 from the &contact of its material and the structure,
+     decelerates at mu g within 3 %; loads.csv's table_by_slider columns (the slider field's part of the
+     table's load) are minus the slider's force in bodies.csv (1e-9 of the peak), and the rest, table -
+     table_by_slider, is minus the force on the stone, a block of a material in no &contact resting on
+     the table (1e-9 of the peak); the stone, under the table's slip condition, does not move;
+  8. bad input of a &contact with a structure: an unknown name, two structures, a name that is both a
+     material and a structure (tests/input/bad has mu < 0).
+
 About 1-2 minutes in the Debug build on 2 cores (the default suite, run_contact).
 
 usage: check_contact.py <flotsam> <mpiexec> <tests/runs/scenes> <scripts folder>"""
@@ -299,6 +308,55 @@ def check_friction(checks, flotsam, scenes):
                                     f"(< one cell; sliding freely it would travel {v0 * 0.1 * 1000:.0f} mm)")
 
 
+# --- 7: a body against a structure ----------------------------------------------------------------------
+
+def check_structure_contact(checks, flotsam, scenes):
+    template = os.path.join(scenes, "contact", "block_on_structure.nml")
+    mu, v0 = 0.2, 1.0
+    if not run(checks, flotsam, template, "on_structure", 2):
+        return
+    directory = flotsam.path("on_structure")
+    frame = bodies(directory)
+    a, stop, rows = sliding_fit(frame, v0)
+    error = a / (mu * G) - 1
+    checks.check(abs(error) <= 0.03, f"structure: the slider on the slip structure with the &contact's mu = 0.2 "
+                                     f"decelerates at {a:.4f} m/s^2 against mu g = {mu * G:.4f}, error {error:+.2%} "
+                                     f"(3 %; {rows} rows), stops at {stop:.4f} s ({v0 / (mu * G):.4f})")
+    loads = pd.read_csv(os.path.join(directory, "loads.csv"), comment="#")
+    merged = pd.merge(frame, loads, on="time")
+    checks.check(len(merged) == len(loads) > 50, f"structure: {len(merged)} rows of loads.csv and bodies.csv at the "
+                                                 "same times")
+    peak = loads[["table_fx", "table_fy"]].abs().to_numpy().max()
+    part = max(abs(merged[f"slider_f{c}"] + merged[f"table_by_slider_f{c}"]).max() for c in "xy")
+    checks.check(part <= 1e-9 * peak, f"structure: table_by_slider_f* = -slider_f* of bodies.csv to {part:.1e} N/m "
+                                      f"(1e-9 of the peak {peak:.1f} N/m)")
+    rest = max(abs(merged[f"table_f{c}"] - merged[f"table_by_slider_f{c}"] + merged[f"stone_f{c}"]).max() for c in "xy")
+    checks.check(rest <= 1e-9 * peak, f"structure: the rest table - table_by_slider = -stone_f* (the common field's "
+                                      f"block) to {rest:.1e} N/m (1e-9 of the peak)")
+    drift = frame["stone_vx"].abs().max()
+    checks.check(drift < 1e-9, f"structure: the stone (common field, the table's slip) stays at rest: "
+                               f"|vx| <= {drift:.1e} m/s")
+    with open(template) as f:
+        text = f.read()
+    bad = [("unknown", text.replace("'wood', 'table'", "'wood', 'tabel'"),
+            "variable between must name declared &material or &structure groups"),
+           ("two_structures", text.replace("&contact between = 'wood', 'table'",
+                                           "&structure name = 'shelf', lower = 0.0, 0.3, upper = 0.2, 0.35 /\n"
+                                           "&contact between = 'shelf', 'table'"),
+            "variable between names two structures"),
+           ("ambiguous", text.replace("name = 'table'", "name = 'wood'").replace("'wood', 'table'", "'wood', 'wood'"),
+            "which is both a &material and a &structure")]
+    for name, scene_text, expected in bad:
+        path = flotsam.path(f"bad_{name}.nml")
+        with open(path, "w") as f:
+            f.write(scene_text)
+        result = flotsam.run(flotsam.scene(path, f"bad_{name}_run.nml", f"bad_{name}"), 2)
+        lines = [line for line in result.stderr.splitlines() if line.startswith("flotsam: error")]
+        checks.check(result.returncode == 2 and len(lines) == 1 and expected in lines[0] and "&contact" in lines[0],
+                     f"structure: bad input ({name}): one line naming the file, &contact, between: "
+                     f"{lines[0] if lines else ''}", result.stderr[-800:])
+
+
 def main():
     flotsam_path, mpiexec, scenes, _ = main_arguments()
     checks = Checks()
@@ -310,6 +368,7 @@ def main():
     check_ranks(checks, flotsam, template, two_ranks)
     check_restart(checks, flotsam_path, mpiexec, template)
     check_friction(checks, flotsam, scenes)
+    check_structure_contact(checks, flotsam, scenes)
     return checks.summary()
 
 
