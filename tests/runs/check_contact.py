@@ -34,7 +34,12 @@
      table's load) are minus the slider's force in bodies.csv (1e-9 of the peak), and the rest, table -
      table_by_slider, is minus the force on the stone, a block of a material in no &contact resting on
      the table (1e-9 of the peak); the stone, under the table's slip condition, does not move;
-  8. bad input of a &contact with a structure: an unknown name, two structures, a name that is both a
+  8. two elastic disks (scenes/contact/two_disks.nml, Sulsky, Chen & Schreyer 1994 head-on, shape
+     'circle'): with &contact they part (rebound coefficient e > 0.6: 0.80 in docs/contact.md), total
+     momentum conserved to 1e-12 of sum m|v|, kinetic energy after in [0.5, 1] of the initial (0.73), no
+     interpenetration beyond one cell along the line of centres; with one field the same run is checked
+     for momentum and printed (they part too, e = 0.70: docs/contact.md);
+  9. bad input of a &contact with a structure: an unknown name, two structures, a name that is both a
      material and a structure (tests/input/bad has mu < 0).
 
 About 1-2 minutes in the Debug build on 2 cores (the default suite, run_contact).
@@ -308,6 +313,51 @@ def check_friction(checks, flotsam, scenes):
                                     f"(< one cell; sliding freely it would travel {v0 * 0.1 * 1000:.0f} mm)")
 
 
+# --- 8: two elastic disks ------------------------------------------------------------------------------
+
+def disk_metrics(directory):
+    """Rebound coefficient, final velocities, momentum drift / sum m|v|, kinetic energy after / before and the
+    smallest gap between the disks' particle cells along the line of centres (y = 0.5 m)."""
+    frame = bodies(directory)
+    before, after = rebound(frame)
+    states = fields(directory)
+    left = states[0]["x"][:, 0] < 1.0          # ids follow the particles: the left disk's, from the start
+    momentum = np.array([(s["m"][:, None] * s["v"]).sum(axis=0) for s in states])
+    scale = max((s["m"][:, None] * np.abs(s["v"])).sum() for s in states)
+    energy = [0.5 * (s["m"] * (s["v"] ** 2).sum(axis=1)).sum() for s in states]
+    gaps = []
+    for s in states:
+        near = np.abs(s["x"][:, 1] - 0.5) < 2 * SPACING
+        gaps.append(s["x"][~left & near, 0].min() - s["x"][left & near, 0].max() - SPACING)
+    return {"e": -after / before, "left": frame["left_vx"].iloc[-1], "right": frame["right_vx"].iloc[-1],
+            "drift": np.abs(momentum - momentum[0]).max() / scale, "energy": energy[-1] / energy[0],
+            "gap": min(gaps), "outputs": len(states)}
+
+
+def check_disks(checks, flotsam, scenes):
+    template = os.path.join(scenes, "contact", "two_disks.nml")
+    with open(template) as f:
+        text = f.read()
+    if run(checks, flotsam, template, "disks", 2):
+        r = disk_metrics(flotsam.path("disks"))
+        checks.check(r["e"] > 0.6 and r["left"] < 0 < r["right"],
+                     f"disks: with &contact they part, velocities {r['left']:.4f} and {r['right']:.4f} m/s after 0.15 "
+                     f"and -0.05, rebound coefficient e = {r['e']:.3f} (> 0.6)")
+        checks.check(r["drift"] <= 1e-12, f"disks: total momentum conserved over {r['outputs']} outputs to "
+                                          f"{r['drift']:.1e} of sum m|v| (1e-12)")
+        checks.check(0.5 <= r["energy"] <= 1.0, f"disks: kinetic energy after the rebound {r['energy']:.3f} of the "
+                                                "initial (in [0.5, 1])")
+        checks.check(r["gap"] > -CELL, f"disks: no interpenetration beyond one cell: the smallest gap along the line "
+                                       f"of centres {r['gap'] * 1000:+.2f} mm (a cell is {CELL * 1000:.0f} mm)")
+    if run(checks, flotsam, template, "disks_single", 2, text=re.sub(r"&contact[^/]*/\n", "", text)):
+        r = disk_metrics(flotsam.path("disks_single"))
+        checks.check(r["drift"] <= 1e-12, f"disks, one field: momentum conserved to {r['drift']:.1e} of sum m|v|")
+        parted = r["left"] < 0 < r["right"]
+        checks.check(True, f"disks, one field: {'they part' if parted else 'they stick'}, velocities "
+                           f"{r['left']:.4f} and {r['right']:.4f} m/s, e = {r['e']:.3f}, kinetic energy after "
+                           f"{r['energy']:.3f}, smallest gap {r['gap'] * 1000:+.2f} mm (printed for docs/contact.md)")
+
+
 # --- 7: a body against a structure ----------------------------------------------------------------------
 
 def check_structure_contact(checks, flotsam, scenes):
@@ -369,6 +419,7 @@ def main():
     check_restart(checks, flotsam_path, mpiexec, template)
     check_friction(checks, flotsam, scenes)
     check_structure_contact(checks, flotsam, scenes)
+    check_disks(checks, flotsam, scenes)
     return checks.summary()
 
 
