@@ -39,7 +39,11 @@
      momentum conserved to 1e-12 of sum m|v|, kinetic energy after in [0.5, 1] of the initial (0.73), no
      interpenetration beyond one cell along the line of centres; with one field the same run is checked
      for momentum and printed (they part too, e = 0.70: docs/contact.md);
-  9. bad input of a &contact with a structure: an unknown name, two structures, a name that is both a
+  9. the paper's floating block (inputs/floating_block.nml) with &contact between = 'block', 'block' (the
+     block gets a field of its own, which touches no other body field) up to t = 0.5 s: bodies.csv,
+     gauges.csv and diagnostics.csv byte for byte those of the scene without it, loads.csv to 1e-14 of
+     each column's largest value (the walls' impulse is summed per field);
+ 10. bad input of a &contact with a structure: an unknown name, two structures, a name that is both a
      material and a structure (tests/input/bad has mu < 0).
 
 About 1-2 minutes in the Debug build on 2 cores (the default suite, run_contact).
@@ -358,6 +362,31 @@ def check_disks(checks, flotsam, scenes):
                            f"{r['energy']:.3f}, smallest gap {r['gap'] * 1000:+.2f} mm (printed for docs/contact.md)")
 
 
+# --- 9: the paper's floating block with a field of its own ---------------------------------------------
+
+def check_floating_block(checks, flotsam, scenes):
+    template = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(scenes))), "inputs", "floating_block.nml")
+    with open(template) as f:
+        text = f.read()
+    settings = {"end_time": "0.5", "checkpoint_interval_wall": "0", "particle_output": ".false.",
+                "grid_output": ".false."}
+    if not (run(checks, flotsam, template, "floating_single", 2, **settings) and
+            run(checks, flotsam, template, "floating_contact", 2, text=text + "&contact between = 'block', 'block' /\n",
+                **settings)):
+        return
+    for file in ["bodies", "gauges", "diagnostics"]:
+        a = csv_data_lines(flotsam.path("floating_single", file + ".csv"))
+        b = csv_data_lines(flotsam.path("floating_contact", file + ".csv"))
+        checks.check(a == b and len(a) > 5, f"floating block: {file}.csv with the block's own field byte for byte "
+                                            f"that of the paper's scene ({len(a)} lines)")
+    a = pd.read_csv(flotsam.path("floating_single", "loads.csv"), comment="#")
+    b = pd.read_csv(flotsam.path("floating_contact", "loads.csv"), comment="#")
+    same = list(a.columns) == list(b.columns)
+    difference = ((a - b).abs().max() / a.abs().max().clip(lower=1e-300)).max() if same else np.inf
+    checks.check(same and difference <= 1e-14, f"floating block: loads.csv has the same columns and values to "
+                                               f"{difference:.1e} of each column's largest (1e-14)")
+
+
 # --- 7: a body against a structure ----------------------------------------------------------------------
 
 def check_structure_contact(checks, flotsam, scenes):
@@ -420,6 +449,7 @@ def main():
     check_friction(checks, flotsam, scenes)
     check_structure_contact(checks, flotsam, scenes)
     check_disks(checks, flotsam, scenes)
+    check_floating_block(checks, flotsam, scenes)
     return checks.summary()
 
 
