@@ -341,32 +341,42 @@ contains
    !> which is exact at a corner of two orthogonal walls (algorithms.md section 4.1); a prescribed velocity,
    !> listed after the scene's walls, wins. With `mass` (nodal masses) and `impulse`, impulse(:, w) gains
    !> the momentum wall w gives the counted nodes, m_i (v_i^c - v_i^*), and its moment (algorithms.md
-   !> section 9.1).
-   pure subroutine apply_wall_constraints(walls, dim, velocity, mass, impulse)
+   !> section 9.1). `friction` (per wall), where >= 0, makes wall w act as a friction wall with that mu
+   !> instead of its own condition: a body field against a structure of its &contact (body_contact).
+   pure subroutine apply_wall_constraints(walls, dim, velocity, mass, impulse, friction)
       type(wall_t), intent(in) :: walls(:)
       integer, intent(in) :: dim
       real(rp), intent(inout) :: velocity(:, :)
       real(rp), intent(in), optional :: mass(:)
       real(rp), intent(inout), optional :: impulse(:, :)
-      integer :: w, i, node
-      real(rp) :: vn, before(dim), n(dim)
+      real(rp), intent(in), optional :: friction(:)
+      integer :: w, i, node, kind
+      real(rp) :: vn, before(dim), n(dim), mu
       logical :: recording
       recording = present(mass) .and. present(impulse)
       do w = 1, size(walls)
          if (.not. walls(w)%active) cycle
          if (.not. walls(w)%shaped) n = walls(w)%normal(1:dim)
+         kind = walls(w)%kind
+         mu = walls(w)%friction
+         if (present(friction)) then
+            if (friction(w) >= 0.0_rp) then
+               kind = wall_kind_friction
+               mu = friction(w)
+            end if
+         end if
          do i = 1, size(walls(w)%nodes)
             node = walls(w)%nodes(i)
             before = velocity(:, node)
             if (walls(w)%shaped) n = walls(w)%node_normal(:, i)
-            select case (walls(w)%kind)
+            select case (kind)
             case (wall_kind_no_slip)
                velocity(:, node) = 0.0_rp
             case (wall_kind_prescribed)
                velocity(:, node) = walls(w)%velocity(1:dim)
             case (wall_kind_friction)
                if (dot_product(before, n) >= 0.0_rp) cycle
-               velocity(:, node) = unilateral_velocity(before, n, walls(w)%friction)
+               velocity(:, node) = unilateral_velocity(before, n, mu)
             case default
                vn = dot_product(before, n)
                if (vn >= 0.0_rp) cycle
@@ -423,13 +433,19 @@ contains
    !> Particle safeguard (algorithms.md section 4.2): a particle found behind a wall (inside its extent
    !> and depth) or inside a structure is put back onto its surface and loses its velocity component into
    !> it (with friction also what Coulomb allows). Counts corrections; impulse(:, w) gains the momentum (and
-   !> its moment) that wall w gave the particles it corrected.
-   subroutine keep_particles_inside(walls, grid, particles, corrections, impulse)
+   !> its moment) that wall w gave the particles it corrected. With contact fields (all three or none):
+   !> `field` (particle) the velocity field of each particle (0: the common one), `field_friction` (wall,
+   !> field) the mu a structure applies to that field instead of its condition (< 0: its condition), and
+   !> field_impulse(:, w, f) gains the part of impulse(:, w) given to field f's particles.
+   subroutine keep_particles_inside(walls, grid, particles, corrections, impulse, field, field_friction, field_impulse)
       type(wall_t), intent(in) :: walls(:)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
       integer, intent(inout) :: corrections
       real(rp), intent(inout) :: impulse(:, :)
+      integer, intent(in), optional :: field(:)
+      real(rp), intent(in), optional :: field_friction(:, :)
+      real(rp), intent(inout), optional :: field_impulse(:, :, :)
       integer :: w, p, d
       real(rp) :: distance, vn, lowest(3), highest(3), before(particles%dim)
       d = particles%dim
@@ -440,7 +456,12 @@ contains
          if (walls(w)%shaped) then
             ! no particle in the structure's box: skip the pass
             if (any(highest(1:d) < walls(w)%box_lower(1:d)) .or. any(lowest(1:d) > walls(w)%box_upper(1:d))) cycle
-            call keep_outside_structure(walls(w), grid, particles, corrections, impulse(:, w))
+            if (present(field)) then
+               call keep_outside_structure(walls(w), grid, particles, corrections, impulse(:, w), field, &
+                                           field_friction(w, :), field_impulse(:, w, :))
+            else
+               call keep_outside_structure(walls(w), grid, particles, corrections, impulse(:, w))
+            end if
             cycle
          end if
          if (walls(w)%axis > 0) then
@@ -482,15 +503,21 @@ contains
    !> share of the tangential one too). Unlike a wall's, it acts at any depth: a structure is solid.
    !> A particle put on a curved surface lands at phi = 0 only to round-off; counting it inside only below
    !> -on_wall_tolerance h keeps the next step's decision (and its change of velocity) from depending on
-   !> that round-off, which differs with the number of ranks.
-   subroutine keep_outside_structure(wall, grid, particles, corrections, impulse)
+   !> that round-off, which differs with the number of ranks. With `field` (particle), a particle of body
+   !> field f > 0 meets Coulomb friction field_friction(f) if that is >= 0, and its impulse is also added
+   !> to field_impulse(:, f).
+   subroutine keep_outside_structure(wall, grid, particles, corrections, impulse, field, field_friction, field_impulse)
       type(wall_t), intent(in) :: wall
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
       integer, intent(inout) :: corrections
       real(rp), intent(inout) :: impulse(:)
-      integer :: p, d
-      real(rp) :: world(particles%dim), phi, n(particles%dim), before(particles%dim), step, tolerance
+      integer, intent(in), optional :: field(:)
+      real(rp), intent(in), optional :: field_friction(:)
+      real(rp), intent(inout), optional :: field_impulse(:, :)
+      integer :: p, d, f, kind
+      real(rp) :: world(particles%dim), phi, n(particles%dim), before(particles%dim), step, tolerance, mu
+      real(rp) :: dp(particles%dim)
       d = particles%dim
       step = normal_step_in_cells * grid%h
       tolerance = on_wall_tolerance * grid%h
@@ -503,13 +530,24 @@ contains
          particles%x(:, p) = particles%x(:, p) - phi * n
          if (dot_product(particles%v(:, p), n) < 0.0_rp) then
             before = particles%v(:, p)
-            if (wall%kind == wall_kind_friction) then
-               particles%v(:, p) = unilateral_velocity(before, n, wall%friction)
+            kind = wall%kind
+            mu = wall%friction
+            f = 0
+            if (present(field)) f = field(p)
+            if (f > 0) then
+               if (field_friction(f) >= 0.0_rp) then
+                  kind = wall_kind_friction
+                  mu = field_friction(f)
+               end if
+            end if
+            if (kind == wall_kind_friction) then
+               particles%v(:, p) = unilateral_velocity(before, n, mu)
             else
                particles%v(:, p) = before - dot_product(before, n) * n
             end if
-            call add_impulse(impulse, particles%mass(p) * (particles%v(:, p) - before), &
-                             particles%x(:, p) - wall%moment_point(1:d))
+            dp = particles%mass(p) * (particles%v(:, p) - before)
+            call add_impulse(impulse, dp, particles%x(:, p) - wall%moment_point(1:d))
+            if (f > 0) call add_impulse(field_impulse(:, f), dp, particles%x(:, p) - wall%moment_point(1:d))
          end if
          corrections = corrections + 1
       end do

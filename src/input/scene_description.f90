@@ -189,12 +189,14 @@ module scene_description
       real(rp) :: radius = 0.0_rp
    end type gauge_spec_t
 
-   !> `&contact`: bodies of two solid materials (or of one, against each other) in contact with their own
-   !> velocity fields, separating and sliding with Coulomb friction (docs/contact.md).
+   !> `&contact`: bodies of two solid materials (or of one, against each other), or of a solid material and
+   !> a `&structure`, in contact with their own velocity fields, separating and sliding with Coulomb
+   !> friction (docs/contact.md).
    type, public :: contact_spec_t
-      character(len=name_len) :: between(2) = ''   !< the two material names (may be the same)
+      character(len=name_len) :: between(2) = ''   !< two material names (may be the same), or a material and a structure
       real(rp) :: friction = 0.0_rp                !< Coulomb coefficient mu >= 0
-      integer :: material_index(2) = 0             !< derived: positions in scene%materials
+      integer :: material_index(2) = 0             !< derived: positions in scene%materials (0: a structure)
+      integer :: structure_index(2) = 0            !< derived: positions in scene%structures (0: a material)
    end type contact_spec_t
 
    !> A whole scene.

@@ -20,7 +20,7 @@ module scene_validation
    implicit none
    private
 
-   public :: validate_scene, resolve_scene, find_material, default_name, side_name
+   public :: validate_scene, resolve_scene, find_material, find_structure, default_name, side_name
    public :: check_scene_memory, scene_particle_count, memory_estimate_per_rank
 
    !> Peak resident memory per particle a run grows by [bytes]: particle arrays, sort buffers and the
@@ -143,7 +143,7 @@ contains
       if (.not. status%ok) return
       if (allocated(scene%contacts)) then
          do i = 1, size(scene%contacts)
-            call validate_contact(scene%contacts, i, scene%materials, path, status)
+            call validate_contact(scene%contacts, i, scene%materials, scene%structures, path, status)
             if (.not. status%ok) return
          end do
       end if
@@ -353,6 +353,11 @@ contains
          end do
       end do
       if (.not. allocated(scene%structures)) allocate (scene%structures(0))
+      do i = 1, size(scene%contacts)
+         do k = 1, 2
+            scene%contacts(i)%structure_index(k) = find_structure(scene%structures, scene%contacts(i)%between(k))
+         end do
+      end do
       do i = 1, size(scene%structures)
          associate (structure => scene%structures(i))
             if (len_trim(structure%name) == 0) structure%name = default_name('structure', i)
@@ -1334,17 +1339,22 @@ contains
    end subroutine validate_gauge
 
    !> `&contact`: two declared solid materials (fluid-solid contact is not implemented: a fluid shares the
-   !> common velocity field, docs/contact.md), a pair no earlier &contact gives (in either order), mu >= 0.
-   subroutine validate_contact(contacts, c, materials, path, status)
+   !> common velocity field, docs/contact.md), or a solid material and a `&structure` (by its name, default
+   !> `structure_<k>`; a name that is both a material and a structure is refused as ambiguous), a pair no
+   !> earlier &contact gives (in either order), mu >= 0.
+   subroutine validate_contact(contacts, c, materials, structures, path, status)
       type(contact_spec_t), intent(in) :: contacts(:)
       integer, intent(in) :: c
       type(material_spec_t), intent(in) :: materials(:)
+      type(structure_spec_t), intent(in), allocatable :: structures(:)
       character(len=*), intent(in) :: path
       type(status_t), intent(inout) :: status
       character(len=:), allocatable :: where
-      character(len=name_len) :: declared(size(materials))
-      integer :: k, m, other
+      character(len=name_len), allocatable :: declared(:)
+      integer :: k, m, s, other, n_structures, found_structures
 
+      n_structures = 0
+      if (allocated(structures)) n_structures = size(structures)
       associate (contact => contacts(c))
          where = group_context(path, 'contact', c)
          if (any(len_trim(contact%between) == 0)) then
@@ -1353,13 +1363,29 @@ contains
             return
          end if
          where = group_context(path, 'contact', c, 'between '//pair_text(contact%between))
+         found_structures = 0
          do k = 1, 2
             m = find_material(materials, contact%between(k))
+            s = 0
+            if (n_structures > 0) s = find_structure(structures, contact%between(k))
+            if (m > 0 .and. s > 0) then
+               call status%fail(where//": variable between names '"//trim(contact%between(k))// &
+                                "', which is both a &material and a &structure; rename one of them")
+               return
+            end if
+            if (s > 0) then
+               found_structures = found_structures + 1
+               cycle
+            end if
             if (m == 0) then
+               allocate (declared(size(materials) + n_structures))
                do m = 1, size(materials)
                   declared(m) = materials(m)%name
                end do
-               call status%fail(where//': variable between must name declared &material groups ('// &
+               do s = 1, n_structures
+                  declared(size(materials) + s) = structure_name(structures, s)
+               end do
+               call status%fail(where//': variable between must name declared &material or &structure groups ('// &
                                 quoted_list(declared)//"), got '"//trim(contact%between(k))//"'")
                return
             end if
@@ -1370,6 +1396,11 @@ contains
                return
             end if
          end do
+         if (found_structures == 2) then
+            call status%fail(where//': variable between names two structures; name a material and a structure '// &
+                             '(structures are fixed: they cannot touch each other)')
+            return
+         end if
          do other = 1, c - 1
             if ((contacts(other)%between(1) == contact%between(1) .and. &
                  contacts(other)%between(2) == contact%between(2)) .or. &
@@ -1383,6 +1414,29 @@ contains
          call check_real(where, 'friction', contact%friction, status, at_least=0.0_rp)
       end associate
    end subroutine validate_contact
+
+   !> The name structure s has in loads.csv: its `name`, or the default `structure_<s>`.
+   pure function structure_name(structures, s) result(name)
+      type(structure_spec_t), intent(in) :: structures(:)
+      integer, intent(in) :: s
+      character(len=name_len) :: name
+      name = structures(s)%name
+      if (len_trim(name) == 0) name = default_name('structure', s)
+   end function structure_name
+
+   !> Index of the structure called `name` (its name or default name); 0 if there is none.
+   pure integer function find_structure(structures, name) result(found)
+      type(structure_spec_t), intent(in) :: structures(:)
+      character(len=*), intent(in) :: name
+      integer :: s
+      found = 0
+      do s = 1, size(structures)
+         if (structure_name(structures, s) == name) then
+            found = s
+            return
+         end if
+      end do
+   end function find_structure
 
    !> "'steel', 'wood'" for messages.
    pure function pair_text(names) result(text)

@@ -16,8 +16,12 @@
 !>     the normal part of v - v_cm and up to mu times it of the tangential part [B00] eq. 19-22, [B01].
 !> Each particle then reads its own field (grid_transfer's multi-field kernels). Without &contact nothing
 !> here runs and the step is the single-field one, bit for bit.
+!> A `&contact` of a material and a `&structure` makes the structure act on that material's body fields
+!> as a friction surface with the pair's mu (its own condition still holds for the other fields), and
+!> the loads keep each body field's share of every wall's impulse (`field_impulse`, loads.csv's
+!> `<structure>_by_<body>` columns).
 module body_contact
-   use kinds, only: rp, i8
+   use kinds, only: rp, i8, name_len
    use scene_description, only: scene_t
    use background_grid, only: grid_t, row_mass
    use particle_set, only: particle_set_t
@@ -26,7 +30,7 @@ module body_contact
    implicit none
    private
 
-   public :: contact_field_rows, resolve_node_contact
+   public :: contact_field_rows, resolve_node_contact, contact_body_names
 
 
    type, public :: contact_t
@@ -39,6 +43,10 @@ module body_contact
       logical, allocatable :: contact_material(:)    !< (material) its bodies are body fields
       !> (field, field): the Coulomb coefficient of the pair's &contact, -1 where none: they stick
       real(rp), allocatable :: friction(:, :)
+      integer :: structures = 0                      !< the scene's &structure groups (the last walls)
+      !> (structure, field): the Coulomb coefficient of the &contact of the field's material and the
+      !> structure, -1 where none: the structure's own condition
+      real(rp), allocatable :: structure_friction(:, :)
       integer, allocatable :: particle_field(:)      !< field of each particle this step (0: common)
       !> (dim (n + 1), node), field f in rows f dim + 1..: v^{n+1} (walls applied) and dv = v^{n+1} - v^n
       real(rp), allocatable :: velocity(:, :), increment(:, :)
@@ -51,6 +59,7 @@ module body_contact
       procedure :: nodal_velocities => contact_nodal_velocities
       procedure :: apply_walls => contact_apply_walls
       procedure :: remapped_velocities => contact_remapped_velocities
+      procedure :: wall_friction => contact_wall_friction
    end type contact_t
 
 contains
@@ -79,8 +88,21 @@ contains
       end do
    end function contact_field_rows
 
+   !> The names of the bodies that are body fields (in field order): the bodies of a material some
+   !> &contact names (all solid, so all tracked by body_motion in the same order).
+   function contact_body_names(scene) result(names)
+      type(scene_t), intent(in) :: scene
+      character(len=name_len), allocatable :: names(:)
+      integer :: b
+      allocate (names(0))
+      if (.not. allocated(scene%bodies)) return
+      do b = 1, size(scene%bodies)
+         if (in_contact(scene, scene%bodies(b)%material_index)) names = [names, scene%bodies(b)%name]
+      end do
+   end function contact_body_names
+
    !> The body fields of the scene: the tracked (solid) bodies of a material in some &contact, their id
-   !> ranges, and the friction of every pair of fields.
+   !> ranges, the friction of every pair of fields and of every structure and field.
    subroutine contact_init(self, scene, bodies, n_materials)
       class(contact_t), intent(inout) :: self
       type(scene_t), intent(in) :: scene
@@ -123,7 +145,31 @@ contains
             end do
          end do
       end do
+      self%structures = 0
+      if (allocated(scene%structures)) self%structures = size(scene%structures)
+      allocate (self%structure_friction(self%structures, n))
+      self%structure_friction = -1.0_rp
+      do f = 1, n
+         do c = 1, size(scene%contacts)
+            associate (contact => scene%contacts(c))
+               do g = 1, 2
+                  if (contact%material_index(g) == material(f) .and. contact%structure_index(3 - g) > 0) &
+                     self%structure_friction(contact%structure_index(3 - g), f) = contact%friction
+               end do
+            end associate
+         end do
+      end do
    end subroutine contact_init
+
+   !> (wall, field) the mu wall w applies to body field f instead of its condition, -1 where none: the
+   !> structures are the last `structures` of the n_walls walls (mpm_solver's build_boundaries).
+   pure function contact_wall_friction(self, n_walls) result(friction)
+      class(contact_t), intent(in) :: self
+      integer, intent(in) :: n_walls
+      real(rp) :: friction(n_walls, self%fields)
+      friction = -1.0_rp
+      if (self%structures > 0) friction(n_walls - self%structures + 1:, :) = self%structure_friction
+   end function contact_wall_friction
 
    !> particle_field(p) for this step's particles: the body field whose id range holds the id (a binary
    !> search over the ascending ranges), 0 for every particle of a material in no &contact.
@@ -235,19 +281,27 @@ contains
    end subroutine contact_nodal_velocities
 
    !> The walls on every field's v^{n+1}, each with its own mass (the impulses add up to the wall's load,
-   !> algorithms.md section 9.1), then dv = v^{n+1} - v^n.
-   subroutine contact_apply_walls(self, walls, grid, impulse)
+   !> algorithms.md section 9.1), a structure with a &contact to a body field's material as a friction
+   !> surface with that mu, then dv = v^{n+1} - v^n. field_impulse(:, w, f) gains body field f's share of
+   !> impulse(:, w).
+   subroutine contact_apply_walls(self, walls, grid, impulse, field_impulse)
       class(contact_t), intent(inout) :: self
       type(wall_t), intent(in) :: walls(:)
       type(grid_t), intent(in) :: grid
       real(rp), intent(inout) :: impulse(:, :)
+      real(rp), intent(inout) :: field_impulse(:, :, :)
+      real(rp) :: friction(size(walls), self%fields), share(size(impulse, 1), size(walls))
       integer :: f, o, dim
       dim = self%dim
+      friction = self%wall_friction(size(walls))
       call apply_wall_constraints(walls, dim, self%velocity(1:dim, :), self%common_mass, impulse)
       do f = 1, self%fields
          o = f * dim
+         share = 0.0_rp
          call apply_wall_constraints(walls, dim, self%velocity(o + 1:o + dim, :), &
-                                     grid%accumulated(self%field_row + (f - 1) * self%stride, :), impulse)
+                                     grid%accumulated(self%field_row + (f - 1) * self%stride, :), share, friction(:, f))
+         impulse = impulse + share
+         field_impulse(:, :, f) = field_impulse(:, :, f) + share
       end do
       self%increment = self%velocity - self%increment
    end subroutine contact_apply_walls
@@ -266,6 +320,7 @@ contains
       integer :: found(self%fields)
       real(rp) :: m, v(grid%dim)
       real(rp) :: fm(self%fields), fv(grid%dim, self%fields), fg(grid%dim, self%fields)
+      real(rp) :: friction(size(walls), self%fields)
       logical :: stuck
 
       dim = grid%dim
@@ -308,9 +363,11 @@ contains
             end do
          end do
       end associate
-      do f = 0, self%fields
+      call apply_wall_constraints(walls, dim, self%remapped(1:dim, :))
+      friction = self%wall_friction(size(walls))
+      do f = 1, self%fields
          o = f * dim
-         call apply_wall_constraints(walls, dim, self%remapped(o + 1:o + dim, :))
+         call apply_wall_constraints(walls, dim, self%remapped(o + 1:o + dim, :), friction=friction(:, f))
       end do
    end subroutine contact_remapped_velocities
 

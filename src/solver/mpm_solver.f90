@@ -474,7 +474,13 @@ contains
       end if
 
       call self%timers%switch_to(phase_walls)
-      call keep_particles_inside(self%walls, self%grid, self%particles, self%wall_corrections, self%loads%step_impulse)
+      if (self%contact%active) then
+         call keep_particles_inside(self%walls, self%grid, self%particles, self%wall_corrections, self%loads%step_impulse, &
+                                    self%contact%particle_field, self%contact%wall_friction(size(self%walls)), &
+                                    self%loads%field_impulse)
+      else
+         call keep_particles_inside(self%walls, self%grid, self%particles, self%wall_corrections, self%loads%step_impulse)
+      end if
       call self%timers%switch_to(phase_loads)
       call self%loads%end_step(self%walls)
       call self%timers%switch_to(phase_inflow)
@@ -533,7 +539,7 @@ contains
       if (self%contact%active) then
          call self%contact%nodal_velocities(self%grid, dt, self%mass_tolerance)
          call self%timers%switch_to(phase_walls)
-         call self%contact%apply_walls(self%walls, self%grid, self%loads%step_impulse)
+         call self%contact%apply_walls(self%walls, self%grid, self%loads%step_impulse, self%loads%field_impulse)
          call self%timers%switch_to(phase_grid_update)
          return
       end if

@@ -8,19 +8,29 @@
 !> per step. A row sums the ranks' impulses (one reduction) and divides by the interval's length,
 !> F = -J / (t - t_prev), so that no impulse is lost between rows. Each rank's impulse is saved in
 !> checkpoints (checkpoint.f90): a restart on the same ranks continues the rows bit for bit.
+!> With contact body fields (body_contact), every structure has one more entry per body field,
+!> `<structure>_by_<body>`: the part of the structure's impulse given to that body's field (nodes and
+!> safeguard); the structure's own entry keeps the total, the rest of which is the common field's.
 module wall_loads
    use kinds, only: rp, name_len
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_SUM
    use scene_description, only: scene_t, wall_spec_t
    use boundary_walls, only: wall_t, impulse_rows, box_side_walls
+   use body_contact, only: contact_body_names
    use world_frame, only: frame_t
    implicit none
    private
 
    type, public :: wall_loads_t
       integer :: dim = 2
-      character(len=name_len), allocatable :: names(:)   !< one entry per wall, box side, inlet and structure
+      !> one entry per wall, box side, inlet and structure, then per structure and body field
+      character(len=2 * name_len + 4), allocatable :: names(:)
       real(rp), allocatable :: step_impulse(:, :)        !< (impulse_rows, wall) this rank, this step
+      integer :: fields = 0                              !< contact body fields
+      integer :: first_structure = 0                     !< entries before the structures'
+      integer :: structures = 0
+      !> (impulse_rows, wall, field) body field f's part of step_impulse(:, wall)
+      real(rp), allocatable :: field_impulse(:, :, :)
       real(rp), allocatable :: impulse(:, :)             !< (impulse_rows, entry) this rank, since last row
       !> time of the last row of loads.csv, gauges.csv and bodies.csv: the start of the interval now
       !> accumulating (0 at the start of a run; saved in checkpoints)
@@ -42,7 +52,9 @@ contains
       class(wall_loads_t), intent(inout) :: self
       type(scene_t), intent(in) :: scene
       type(wall_spec_t), allocatable :: sides(:)
-      integer :: n_walls, n_inlets, n_structures, before
+      character(len=name_len), allocatable :: bodies(:)
+      character(len=2 * name_len + 4) :: entry
+      integer :: n_walls, n_inlets, n_structures, before, s, f
       self%dim = scene%grid%dim
       sides = box_side_walls(scene%grid)
       n_walls = 0
@@ -58,6 +70,17 @@ contains
       if (n_inlets > 0) self%names(before + 1:before + n_inlets) = scene%inlets%name
       before = before + n_inlets
       if (n_structures > 0) self%names(before + 1:) = scene%structures%name
+      self%first_structure = before
+      self%structures = n_structures
+      ! the entries per structure and body field: only with contact fields, so other scenes keep their columns
+      bodies = contact_body_names(scene)
+      self%fields = size(bodies)
+      do s = 1, n_structures
+         do f = 1, self%fields
+            entry = trim(scene%structures(s)%name)//'_by_'//trim(bodies(f))
+            self%names = [self%names, entry]
+         end do
+      end do
       allocate (self%impulse(impulse_rows, size(self%names)))
       self%impulse = 0.0_rp
    end subroutine loads_init
@@ -72,15 +95,29 @@ contains
          allocate (self%step_impulse(impulse_rows, n_walls))
       end if
       self%step_impulse = 0.0_rp
+      if (allocated(self%field_impulse)) then
+         if (size(self%field_impulse, 2) /= n_walls) deallocate (self%field_impulse)
+      end if
+      if (.not. allocated(self%field_impulse)) allocate (self%field_impulse(impulse_rows, n_walls, self%fields))
+      self%field_impulse = 0.0_rp
    end subroutine loads_begin_step
 
    !> Add this step's impulses to this rank's impulse since the last row (per loads.csv entry).
    subroutine loads_end_step(self, walls)
       class(wall_loads_t), intent(inout) :: self
       type(wall_t), intent(in) :: walls(:)
-      integer :: w
+      integer :: w, s, f, e
       do w = 1, size(walls)
          if (walls(w)%load > 0) self%impulse(:, walls(w)%load) = self%impulse(:, walls(w)%load) + self%step_impulse(:, w)
+      end do
+      if (self%fields == 0) return
+      do w = 1, size(walls)
+         s = walls(w)%load - self%first_structure
+         if (.not. walls(w)%shaped .or. s < 1 .or. s > self%structures) cycle
+         do f = 1, self%fields
+            e = self%first_structure + self%structures + (s - 1) * self%fields + f
+            self%impulse(:, e) = self%impulse(:, e) + self%field_impulse(:, w, f)
+         end do
       end do
    end subroutine loads_end_step
 
@@ -121,7 +158,7 @@ contains
    !> Column names of loads.csv after `time`, in the order of row_values.
    function loads_column_names(self) result(columns)
       class(wall_loads_t), intent(in) :: self
-      character(len=name_len + 3), allocatable :: columns(:)
+      character(len=2 * name_len + 7), allocatable :: columns(:)
       character(len=*), parameter :: suffixes_2d(3) = ['_fx', '_fy', '_mz']
       character(len=*), parameter :: suffixes_3d(6) = ['_fx', '_fy', '_fz', '_mx', '_my', '_mz']
       integer :: e, s, n

@@ -28,6 +28,24 @@
      at v0 / (mu g) within 3 %; with mu = 0 it keeps its speed (deceleration below 3 % of 0.2 g); with one
      velocity field it sticks to the base (its centroid stays within a cell of where it started).
 
+  7. a body against a structure (scenes/contact/block_on_structure.nml): a block sliding on a box structure
+     whose own condition is slip, with mu = 0.2 from the &contact of its material and the structure,
+     decelerates at mu g within 3 %; loads.csv's table_by_slider columns (the slider field's part of the
+     table's load) are minus the slider's force in bodies.csv (1e-9 of the peak), and the rest, table -
+     table_by_slider, is minus the force on the stone, a block of a material in no &contact resting on
+     the table (1e-9 of the peak); the stone, under the table's slip condition, does not move;
+  8. two elastic disks (scenes/contact/two_disks.nml, Sulsky, Chen & Schreyer 1994 head-on, shape
+     'circle'): with &contact they part (rebound coefficient e > 0.6: 0.80 in docs/contact.md), total
+     momentum conserved to 1e-12 of sum m|v|, kinetic energy after in [0.5, 1] of the initial (0.73), no
+     interpenetration beyond one cell along the line of centres; with one field the same run is checked
+     for momentum and printed (they part too, e = 0.70: docs/contact.md);
+  9. the paper's floating block (inputs/floating_block.nml) with &contact between = 'block', 'block' (the
+     block gets a field of its own, which touches no other body field) up to t = 0.5 s: bodies.csv,
+     gauges.csv and diagnostics.csv byte for byte those of the scene without it, loads.csv to 1e-14 of
+     each column's largest value (the walls' impulse is summed per field);
+ 10. bad input of a &contact with a structure: an unknown name, two structures, a name that is both a
+     material and a structure (tests/input/bad has mu < 0).
+
 About 1-2 minutes in the Debug build on 2 cores (the default suite, run_contact).
 
 usage: check_contact.py <flotsam> <mpiexec> <tests/runs/scenes> <scripts folder>"""
@@ -299,6 +317,125 @@ def check_friction(checks, flotsam, scenes):
                                     f"(< one cell; sliding freely it would travel {v0 * 0.1 * 1000:.0f} mm)")
 
 
+# --- 8: two elastic disks ------------------------------------------------------------------------------
+
+def disk_metrics(directory):
+    """Rebound coefficient, final velocities, momentum drift / sum m|v|, kinetic energy after / before and the
+    smallest gap between the disks' particle cells along the line of centres (y = 0.5 m)."""
+    frame = bodies(directory)
+    before, after = rebound(frame)
+    states = fields(directory)
+    left = states[0]["x"][:, 0] < 1.0          # ids follow the particles: the left disk's, from the start
+    momentum = np.array([(s["m"][:, None] * s["v"]).sum(axis=0) for s in states])
+    scale = max((s["m"][:, None] * np.abs(s["v"])).sum() for s in states)
+    energy = [0.5 * (s["m"] * (s["v"] ** 2).sum(axis=1)).sum() for s in states]
+    gaps = []
+    for s in states:
+        near = np.abs(s["x"][:, 1] - 0.5) < 2 * SPACING
+        gaps.append(s["x"][~left & near, 0].min() - s["x"][left & near, 0].max() - SPACING)
+    return {"e": -after / before, "left": frame["left_vx"].iloc[-1], "right": frame["right_vx"].iloc[-1],
+            "drift": np.abs(momentum - momentum[0]).max() / scale, "energy": energy[-1] / energy[0],
+            "gap": min(gaps), "outputs": len(states)}
+
+
+def check_disks(checks, flotsam, scenes):
+    template = os.path.join(scenes, "contact", "two_disks.nml")
+    with open(template) as f:
+        text = f.read()
+    if run(checks, flotsam, template, "disks", 2):
+        r = disk_metrics(flotsam.path("disks"))
+        checks.check(r["e"] > 0.6 and r["left"] < 0 < r["right"],
+                     f"disks: with &contact they part, velocities {r['left']:.4f} and {r['right']:.4f} m/s after 0.15 "
+                     f"and -0.05, rebound coefficient e = {r['e']:.3f} (> 0.6)")
+        checks.check(r["drift"] <= 1e-12, f"disks: total momentum conserved over {r['outputs']} outputs to "
+                                          f"{r['drift']:.1e} of sum m|v| (1e-12)")
+        checks.check(0.5 <= r["energy"] <= 1.0, f"disks: kinetic energy after the rebound {r['energy']:.3f} of the "
+                                                "initial (in [0.5, 1])")
+        checks.check(r["gap"] > -CELL, f"disks: no interpenetration beyond one cell: the smallest gap along the line "
+                                       f"of centres {r['gap'] * 1000:+.2f} mm (a cell is {CELL * 1000:.0f} mm)")
+    if run(checks, flotsam, template, "disks_single", 2, text=re.sub(r"&contact[^/]*/\n", "", text)):
+        r = disk_metrics(flotsam.path("disks_single"))
+        checks.check(r["drift"] <= 1e-12, f"disks, one field: momentum conserved to {r['drift']:.1e} of sum m|v|")
+        parted = r["left"] < 0 < r["right"]
+        checks.check(True, f"disks, one field: {'they part' if parted else 'they stick'}, velocities "
+                           f"{r['left']:.4f} and {r['right']:.4f} m/s, e = {r['e']:.3f}, kinetic energy after "
+                           f"{r['energy']:.3f}, smallest gap {r['gap'] * 1000:+.2f} mm (printed for docs/contact.md)")
+
+
+# --- 9: the paper's floating block with a field of its own ---------------------------------------------
+
+def check_floating_block(checks, flotsam, scenes):
+    template = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(scenes))), "inputs", "floating_block.nml")
+    with open(template) as f:
+        text = f.read()
+    settings = {"end_time": "0.5", "checkpoint_interval_wall": "0", "particle_output": ".false.",
+                "grid_output": ".false."}
+    if not (run(checks, flotsam, template, "floating_single", 2, **settings) and
+            run(checks, flotsam, template, "floating_contact", 2, text=text + "&contact between = 'block', 'block' /\n",
+                **settings)):
+        return
+    for file in ["bodies", "gauges", "diagnostics"]:
+        a = csv_data_lines(flotsam.path("floating_single", file + ".csv"))
+        b = csv_data_lines(flotsam.path("floating_contact", file + ".csv"))
+        checks.check(a == b and len(a) > 5, f"floating block: {file}.csv with the block's own field byte for byte "
+                                            f"that of the paper's scene ({len(a)} lines)")
+    a = pd.read_csv(flotsam.path("floating_single", "loads.csv"), comment="#")
+    b = pd.read_csv(flotsam.path("floating_contact", "loads.csv"), comment="#")
+    same = list(a.columns) == list(b.columns)
+    difference = ((a - b).abs().max() / a.abs().max().clip(lower=1e-300)).max() if same else np.inf
+    checks.check(same and difference <= 1e-14, f"floating block: loads.csv has the same columns and values to "
+                                               f"{difference:.1e} of each column's largest (1e-14)")
+
+
+# --- 7: a body against a structure ----------------------------------------------------------------------
+
+def check_structure_contact(checks, flotsam, scenes):
+    template = os.path.join(scenes, "contact", "block_on_structure.nml")
+    mu, v0 = 0.2, 1.0
+    if not run(checks, flotsam, template, "on_structure", 2):
+        return
+    directory = flotsam.path("on_structure")
+    frame = bodies(directory)
+    a, stop, rows = sliding_fit(frame, v0)
+    error = a / (mu * G) - 1
+    checks.check(abs(error) <= 0.03, f"structure: the slider on the slip structure with the &contact's mu = 0.2 "
+                                     f"decelerates at {a:.4f} m/s^2 against mu g = {mu * G:.4f}, error {error:+.2%} "
+                                     f"(3 %; {rows} rows), stops at {stop:.4f} s ({v0 / (mu * G):.4f})")
+    loads = pd.read_csv(os.path.join(directory, "loads.csv"), comment="#")
+    merged = pd.merge(frame, loads, on="time")
+    checks.check(len(merged) == len(loads) > 50, f"structure: {len(merged)} rows of loads.csv and bodies.csv at the "
+                                                 "same times")
+    peak = loads[["table_fx", "table_fy"]].abs().to_numpy().max()
+    part = max(abs(merged[f"slider_f{c}"] + merged[f"table_by_slider_f{c}"]).max() for c in "xy")
+    checks.check(part <= 1e-9 * peak, f"structure: table_by_slider_f* = -slider_f* of bodies.csv to {part:.1e} N/m "
+                                      f"(1e-9 of the peak {peak:.1f} N/m)")
+    rest = max(abs(merged[f"table_f{c}"] - merged[f"table_by_slider_f{c}"] + merged[f"stone_f{c}"]).max() for c in "xy")
+    checks.check(rest <= 1e-9 * peak, f"structure: the rest table - table_by_slider = -stone_f* (the common field's "
+                                      f"block) to {rest:.1e} N/m (1e-9 of the peak)")
+    drift = frame["stone_vx"].abs().max()
+    checks.check(drift < 1e-9, f"structure: the stone (common field, the table's slip) stays at rest: "
+                               f"|vx| <= {drift:.1e} m/s")
+    with open(template) as f:
+        text = f.read()
+    bad = [("unknown", text.replace("'wood', 'table'", "'wood', 'tabel'"),
+            "variable between must name declared &material or &structure groups"),
+           ("two_structures", text.replace("&contact between = 'wood', 'table'",
+                                           "&structure name = 'shelf', lower = 0.0, 0.3, upper = 0.2, 0.35 /\n"
+                                           "&contact between = 'shelf', 'table'"),
+            "variable between names two structures"),
+           ("ambiguous", text.replace("name = 'table'", "name = 'wood'").replace("'wood', 'table'", "'wood', 'wood'"),
+            "which is both a &material and a &structure")]
+    for name, scene_text, expected in bad:
+        path = flotsam.path(f"bad_{name}.nml")
+        with open(path, "w") as f:
+            f.write(scene_text)
+        result = flotsam.run(flotsam.scene(path, f"bad_{name}_run.nml", f"bad_{name}"), 2)
+        lines = [line for line in result.stderr.splitlines() if line.startswith("flotsam: error")]
+        checks.check(result.returncode == 2 and len(lines) == 1 and expected in lines[0] and "&contact" in lines[0],
+                     f"structure: bad input ({name}): one line naming the file, &contact, between: "
+                     f"{lines[0] if lines else ''}", result.stderr[-800:])
+
+
 def main():
     flotsam_path, mpiexec, scenes, _ = main_arguments()
     checks = Checks()
@@ -310,6 +447,9 @@ def main():
     check_ranks(checks, flotsam, template, two_ranks)
     check_restart(checks, flotsam_path, mpiexec, template)
     check_friction(checks, flotsam, scenes)
+    check_structure_contact(checks, flotsam, scenes)
+    check_disks(checks, flotsam, scenes)
+    check_floating_block(checks, flotsam, scenes)
     return checks.summary()
 
 
