@@ -186,15 +186,8 @@ contains
             end do
          end do
       end do
-      wall%nodes = found(1:n)
-      wall%counted = owned(1:n)
+      call keep_nodes(wall, grid, found(1:n), owned(1:n))
       wall%node_normal = normals(:, 1:n)
-      allocate (wall%arm(3, n))
-      wall%arm = 0.0_rp
-      do i = 1, n
-         g(1:dim) = grid%node_indices(found(i))
-         wall%arm(1:dim, i) = grid%origin(1:dim) + g(1:dim) * grid%h - wall%moment_point(1:dim)
-      end do
    end function make_structure
 
    !> The sides of the scene box that `&box_walls` makes walls, as `&wall` entries: each is the face of
@@ -281,15 +274,26 @@ contains
             end do
          end do
       end do
-      wall%nodes = found(1:n)
-      wall%counted = owned(1:n)
-      allocate (wall%arm(3, n))
-      wall%arm = 0.0_rp
-      do i = 1, n
-         g(1:dim) = grid%node_indices(found(i))
-         wall%arm(1:dim, i) = grid%origin(1:dim) + g(1:dim) * grid%h - wall%moment_point(1:dim)
-      end do
+      call keep_nodes(wall, grid, found(1:n), owned(1:n))
    end function make_wall
+
+   !> The wall's local nodes `nodes`, which of them this rank counts in the loads (`owned`), and each
+   !> node's arm from the moment point (grid frame).
+   subroutine keep_nodes(wall, grid, nodes, owned)
+      type(wall_t), intent(inout) :: wall
+      type(grid_t), intent(in) :: grid
+      integer, intent(in) :: nodes(:)
+      logical, intent(in) :: owned(:)
+      integer :: i, dim
+      dim = grid%dim
+      wall%nodes = nodes
+      wall%counted = owned
+      allocate (wall%arm(3, size(nodes)))
+      wall%arm = 0.0_rp
+      do i = 1, size(nodes)
+         wall%arm(1:dim, i) = grid%origin(1:dim) + grid%node_indices(nodes(i)) * grid%h - wall%moment_point(1:dim)
+      end do
+   end subroutine keep_nodes
 
    !> True if the grid-frame point x lies on the wall or behind it (within `tolerance` in front), not
    !> farther behind than the wall's depth, with its foot point inside the wall's extent. `widen` [m]

@@ -14,14 +14,13 @@ module scene_reader
    use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
                                 inlet_spec_t, gauge_spec_t, structure_spec_t, contact_spec_t, model_newtonian_fluid, &
                                 model_linear_elastic
-   use shape_geometry, only: max_vertices, no_vertex
+   use shape_geometry, only: shape_t, max_vertices, no_vertex
    use namelist_scan, only: namelist_file_t, namelist_group_t, scan_namelist_file
    use scene_validation, only: validate_scene, resolve_scene, check_scene_memory, default_name, stabilization_keywords, &
                                oscillation_rule_keywords
    use scene_broadcast, only: broadcast_scene
    use status_broadcast, only: broadcast_status
    use input_text, only: lower_case, upper_case, int_text, ordinal, group_context, canonical_keyword
-   use shape_geometry, only: max_vertices
    use point_file, only: load_body_points
    implicit none
    private
@@ -1083,15 +1082,7 @@ contains
       shape = spec%shape%kind
       lower = spec%lower
       upper = spec%upper
-      centre = spec%shape%centre
-      size = spec%shape%size
-      rotation = spec%shape%rotation
-      rotation_axis = spec%shape%rotation_axis
-      radius = spec%shape%radius
-      axis = spec%shape%axis
-      length = spec%shape%length
-      vertices = reshape(spec%shape%vertices, [2 * max_vertices])
-      z_range = spec%shape%z_range
+      call shape_to_locals(spec%shape, centre, size, rotation, rotation_axis, radius, axis, length, vertices, z_range)
       points_file = spec%points_file
       points_checksum = spec%points_checksum
       particles_per_cell = spec%particles_per_cell
@@ -1107,15 +1098,7 @@ contains
       if (ios /= 0) return
       spec%lower = lower
       spec%upper = upper
-      spec%shape%centre = centre
-      spec%shape%size = size
-      spec%shape%rotation = rotation
-      spec%shape%rotation_axis = rotation_axis
-      spec%shape%radius = radius
-      spec%shape%axis = axis
-      spec%shape%length = length
-      spec%shape%vertices = reshape(vertices, [2, max_vertices])
-      spec%shape%z_range = z_range
+      call locals_to_shape(centre, size, rotation, rotation_axis, radius, axis, length, vertices, z_range, spec%shape)
       spec%particles_per_cell = particles_per_cell
       spec%velocity = velocity
       spec%hydrostatic = hydrostatic
@@ -1166,15 +1149,7 @@ contains
 
       name = spec%name
       shape = spec%shape%kind
-      centre = spec%shape%centre
-      size = spec%shape%size
-      rotation = spec%shape%rotation
-      rotation_axis = spec%shape%rotation_axis
-      radius = spec%shape%radius
-      axis = spec%shape%axis
-      length = spec%shape%length
-      vertices = no_vertex
-      z_range = spec%shape%z_range
+      call shape_to_locals(spec%shape, centre, size, rotation, rotation_axis, radius, axis, length, vertices, z_range)
       lower = spec%lower
       upper = spec%upper
       condition = spec%condition
@@ -1185,20 +1160,46 @@ contains
       call take_text('shape', shape, spec%shape%kind, ios, message, fold='lower')
       call take_text('condition', condition, spec%condition, ios, message, fold='lower')
       if (ios /= 0) return
-      spec%shape%centre = centre
-      spec%shape%size = size
-      spec%shape%rotation = rotation
-      spec%shape%rotation_axis = rotation_axis
-      spec%shape%radius = radius
-      spec%shape%axis = axis
-      spec%shape%length = length
-      if (any(vertex_given(vertices))) spec%shape%vertices = reshape(vertices, [2, max_vertices])
-      spec%shape%z_range = z_range
+      call locals_to_shape(centre, size, rotation, rotation_axis, radius, axis, length, vertices, z_range, spec%shape)
       spec%lower = lower
       spec%upper = upper
       spec%friction = friction
       spec%moment_point = moment_point
    end subroutine read_structure_group
+
+   !> The numbers of a shape as the namelist variables of a group that takes one (&body, &structure). The
+   !> vertices start empty: a list that is read replaces the shape's whole list (an override with fewer
+   !> vertices leaves none of the old ones behind), a group without `vertices` keeps them (locals_to_shape).
+   pure subroutine shape_to_locals(shape, centre, size, rotation, rotation_axis, radius, axis, length, vertices, z_range)
+      type(shape_t), intent(in) :: shape
+      real(rp), intent(out) :: centre(3), size(3), rotation, rotation_axis(3), radius, axis(3), length, &
+                               vertices(2 * max_vertices), z_range(2)
+      centre = shape%centre
+      size = shape%size
+      rotation = shape%rotation
+      rotation_axis = shape%rotation_axis
+      radius = shape%radius
+      axis = shape%axis
+      length = shape%length
+      vertices = no_vertex
+      z_range = shape%z_range
+   end subroutine shape_to_locals
+
+   !> The namelist variables read back into the shape (see shape_to_locals; its kind is read as text).
+   pure subroutine locals_to_shape(centre, size, rotation, rotation_axis, radius, axis, length, vertices, z_range, shape)
+      real(rp), intent(in) :: centre(3), size(3), rotation, rotation_axis(3), radius, axis(3), length, &
+                              vertices(2 * max_vertices), z_range(2)
+      type(shape_t), intent(inout) :: shape
+      shape%centre = centre
+      shape%size = size
+      shape%rotation = rotation
+      shape%rotation_axis = rotation_axis
+      shape%radius = radius
+      shape%axis = axis
+      shape%length = length
+      if (any(vertex_given(vertices))) shape%vertices = reshape(vertices, [2, max_vertices])
+      shape%z_range = z_range
+   end subroutine locals_to_shape
 
    !> A value of a vertex list that is not the 'none' marker (a NaN is given: validation reports it).
    elemental logical function vertex_given(value) result(given)
