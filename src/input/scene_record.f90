@@ -461,26 +461,6 @@ contains
       end associate
    end function structure_value
 
-   !> The vertices given, as the flat list x1, y1, x2, y2, ... that `vertices` reads; without any, the one
-   !> value that stands for none (shape_geometry's no_vertex), so that the text still reads back.
-   function vertex_list(vertices) result(text)
-      real(rp), intent(in) :: vertices(:, :)
-      character(len=:), allocatable :: text
-      real(rp), allocatable :: flat(:)
-      integer :: n
-      flat = reshape(vertices, [size(vertices)])
-      n = 0
-      do while (n < size(flat))
-         if (flat(n + 1) >= no_vertex) exit
-         n = n + 1
-      end do
-      if (n == 0) then
-         text = real_text(no_vertex)
-      else
-         text = reals(flat(1:n))
-      end if
-   end function vertex_list
-
    !> 'text' with an apostrophe doubled, trailing blanks removed.
    pure function quoted(value) result(text)
       character(len=*), intent(in) :: value
