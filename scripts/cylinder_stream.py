@@ -72,7 +72,8 @@ def main():
     out = os.path.abspath(args.out)
     os.makedirs(out, exist_ok=True)
     lines = ["| h [m] | R/h | run time [s] | mean drag F [N/m] | fluctuation (std) [N/m] | "
-             "C_D = F / (0.5 rho U^2 D) | mean lift [N/m] |", "|---|---|---|---|---|---|---|"]
+             "C_D = F / (0.5 rho U^2 D) | mean drag, 1st / 2nd half of the window [N/m] | mean lift [N/m] |",
+             "|---|---|---|---|---|---|---|---|"]
     fig, ax = plt.subplots(figsize=(7, 4))
     failed = 0
     for cell in cells:
@@ -90,9 +91,11 @@ def main():
         t, fx, fy = loads["time"], loads["cylinder_fx"], loads["cylinder_fy"]
         window = (t > t0 + 1e-9) & (t <= t1 + 1e-9)
         mean, std = fx[window].mean(), fx[window].std()
+        middle = 0.5 * (t0 + t1)
+        halves = fx[window & (t <= middle + 1e-9)].mean(), fx[window & (t > middle + 1e-9)].mean()
         cd = mean / (0.5 * RHO * U * U * 2 * RADIUS)
         lines.append(f"| {cell} | {RADIUS / cell:.1f} | {seconds:.0f} | {mean:.1f} | {std:.1f} ({std / mean:.1%}) | "
-                     f"{cd:.2f} | {fy[window].mean():+.1f} |")
+                     f"{cd:.2f} | {halves[0]:.1f} / {halves[1]:.1f} | {fy[window].mean():+.1f} |")
         print(lines[-1], flush=True)
         ax.plot(t, fx, lw=0.8, label=f"h = {cell} m (R/h = {RADIUS / cell:.1f})")
     ax.axvspan(t0, t1, color="0.9", zorder=0, label="averaging window")
