@@ -15,7 +15,8 @@ report  from loads.csv ('column_f*'), bodies.csv ('debris_*') and the particle f
         velocity; with a water-only run, its peak too (what the water alone puts on the column); and
         a plot of the column's force history (both runs) with the block's x velocity.
 peaks   one row per case of a finished study: cell size, particles per cell, the column's peak force
-        and its time, the run's wall time (from the study's results.csv).
+        and its time, the impulse on the column within 10 ms of the peak (each row the mean force over
+        its interval), the steps and the run's wall time (from the study's results.csv).
 Exit status 1 if a run failed or a block particle is inside the column.
 """
 
@@ -117,7 +118,9 @@ def report(folder, water=None, png=None):
               f"mean over the last 0.3 s {w['column_fx'][w['time'] > w['time'][-1] - 0.3].mean():.1f} {unit}")
         ax.plot(w["time"], w["column_fx"], lw=0.8, label="water only (no block)")
     ax.set_ylabel(f"column force x [{unit}]")
-    ax.set_title(f"{os.path.basename(os.path.normpath(folder))}: loads.csv column_fx ({(t[1] - t[0]) * 1000:.0f} ms rows)")
+    with h5py.File(sorted(glob.glob(os.path.join(folder, "fields", "fields_*.h5")))[0]) as f:
+        scene = os.path.basename(f.attrs["scene_file"].decode())
+    ax.set_title(f"{scene}: loads.csv column_fx ({(t[1] - t[0]) * 1000:.0f} ms rows)")
     ax.legend(fontsize=8)
     bx.plot(bodies["time"], bodies["debris_vx"], color="C2", lw=0.8)
     bx.set_ylabel("block v_x [m/s]")
@@ -149,15 +152,19 @@ def run(scene, out, ranks, flotsam):
 def peaks(output):
     with open(os.path.join(output, "results.csv")) as f:
         rows = list(csv.DictReader(f))
-    print("| cell size [m] | particles per cell | peak column force [N/m] | at t [s] | wall time [s] |")
-    print("|---|---|---|---|---|")
+    print("| cell size [m] | particles per cell | peak column force [N/m] | at t [s] | impulse t_peak ± 10 ms [N s/m] "
+          "| steps | wall time [s] | particle-steps/s per core |")
+    print("|---|---|---|---|---|---|---|---|")
     for row in rows:
         loads = read_csv(os.path.join(output, "cases", row["case"], "loads.csv"))
         i = int(np.argmax(loads["column_fx"]))
         cell = next(v for k, v in row.items() if k.endswith("cell_size"))
         ppc = next(v for k, v in row.items() if k.endswith("particles_per_cell"))
-        print(f"| {cell} | {ppc} | {loads['column_fx'][i]:.0f} | {loads['time'][i]:.3f} | "
-              f"{float(row['wall_seconds']):.0f} |")
+        t = loads["time"]
+        near = np.abs(t - t[i]) <= 0.01 + 1e-9
+        impulse = (loads["column_fx"][near] * np.diff(np.concatenate([[0.0], t]))[near]).sum()
+        print(f"| {cell} | {ppc} | {loads['column_fx'][i]:.0f} | {t[i]:.3f} | {impulse:.1f} | {row['steps']} | "
+              f"{float(row['wall_seconds']):.0f} | {float(row['particle_steps_per_second_per_core']):.3g} |")
     return True
 
 
