@@ -1,8 +1,10 @@
 #!/usr/bin/python3
 """Short versions of the paper's scenes (inputs/tank_filling.nml, hydrostatic_tank.nml at 45 degrees,
-floating_block.nml), run from the files themselves with only the end time and output folder changed
-(scripts/scene_variant.py), and checked for: mass conservation, the inflow mass flux rho v0 H (within
-1 %, and layer by layer), no particle behind a wall, unique ids, and a block that stays intact.
+floating_block.nml) and of the debris scenes (debris_column_2d.nml, debris_column_3d.nml), run from the
+files themselves with only the end time, the output folder and (debris: a smoke run in Debug) the cell
+size changed (scripts/scene_variant.py), and checked for: mass conservation, the inflow mass flux
+rho v0 H (within 1 %, and layer by layer), no particle behind a wall, unique ids, a block that stays
+intact, and no debris particle inside the column.
 The full reproductions are scripts/paper_figures.py (CTest label validation).
 
 usage: check_scenes.py <flotsam> <mpiexec> <tests/runs/scenes> <scripts folder>"""
@@ -110,6 +112,31 @@ def main():
         # intact: the particle cloud keeps the block's size (0.4 m less one spacing between the outer
         # particles) within a spacing either way
         checks.check(np.all(np.abs(size - (0.4 - 0.1 / 3)) < 0.1 / 3), "block: stays intact (size kept)", str(size))
+
+    # debris scenes, smoke runs: the 2-D one coarse (h = 0.04) through the block's impact on the column
+    # (at 0.51 s), the 3-D one at its own resolution for 0.02 s (the full runs: scripts/debris_column.py)
+    for scene, name, changes in (
+            ("debris_column_2d.nml", "debris2d", {"run": {"end_time": "0.6", "output_interval": "0.05"},
+                                                  "grid": {"cell_size": "0.04"}}),
+            ("debris_column_3d.nml", "debris3d", {"run": {"end_time": "0.02", "output_interval": "0.01"}})):
+        rows, folder = run(checks, flotsam, inputs, scene, name, 2, changes)
+        if not rows:
+            continue
+        mass = [float(r["total_mass"]) for r in rows]
+        checks.close(mass[-1], mass[0], 1e-12, f"{name}: mass kept")
+        state = final_particles(folder, rows)
+        x, block = state["position"], state["material"] == 2
+        checks.check(len(np.unique(state["id"])) == len(state["id"]), f"{name}: ids unique")
+        dim = 3 if name == "debris3d" else 2
+        # the column of the scene file: 2-D x 2.0 .. 2.1, y < 0.3; 3-D x 1.6 .. 1.72, y 0.24 .. 0.36
+        lower, upper = ((2.0, 0.0), (2.1, 0.3)) if dim == 2 else ((1.6, 0.24, 0.0), (1.72, 0.36, 0.8))
+        inside = np.all((x[block, :dim] > lower) & (x[block, :dim] < upper), axis=1).sum()
+        checks.check(block.any() and inside == 0, f"{name}: no debris particle inside the column",
+                     f"{inside} of {block.sum()}")
+        if dim == 2:
+            # carried from x = 1.275 m to the column (its centroid half a block, 0.075 m, before the face)
+            front = x[block, 0].mean() + 0.075
+            checks.check(front > 1.9, f"{name}: the surge carries the block to the column", f"front at {front:.3f} m")
 
     sys.exit(checks.summary())
 
