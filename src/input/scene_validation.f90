@@ -30,6 +30,10 @@ module scene_validation
    !> Grid memory per node [bytes]: mass, momentum, force, velocity and its increment, MUSL's remapped
    !> momentum (1 + 5 dim reals), doubled for halos, stabilization and grid output. [R]
    integer(i8), parameter :: bytes_per_node(2:3) = [2_i8 * 8_i8 * 11_i8, 2_i8 * 8_i8 * 16_i8]
+   !> Grid memory per node of each body with a velocity field of its own (&contact, body_contact): its
+   !> mass, momentum, force and mass gradient in the accumulated rows, velocity, increment and MUSL's
+   !> remapped momentum (1 + 6 dim reals), doubled for halos. [R]
+   integer(i8), parameter :: bytes_per_field_node(2:3) = [2_i8 * 8_i8 * 13_i8, 2_i8 * 8_i8 * 19_i8]
 
    !> Accepted `&material stabilization=` keywords in their canonical spelling (compared without case).
    character(len=*), parameter, public :: stabilization_keywords(*) = [character(len=5) :: 'none', 'C0', 'NB', 'FOAL1']
@@ -210,8 +214,25 @@ contains
       else
          total = scene_particle_count(scene)
       end if
-      bytes = (real(bytes_per_particle(dim), rp) * total + real(bytes_per_node(dim), rp) * nodes) / ranks
+      bytes = (real(bytes_per_particle(dim), rp) * total + &
+               real(bytes_per_node(dim) + contact_field_count(scene) * bytes_per_field_node(dim), rp) * nodes) / ranks
    end function memory_estimate_per_rank
+
+   !> Bodies that get a velocity field of their own: those of a material some `&contact` names.
+   pure integer function contact_field_count(scene) result(fields)
+      type(scene_t), intent(in) :: scene
+      integer :: b, c
+      fields = 0
+      if (.not. allocated(scene%contacts) .or. .not. allocated(scene%bodies)) return
+      do b = 1, size(scene%bodies)
+         do c = 1, size(scene%contacts)
+            if (any(scene%contacts(c)%material_index == scene%bodies(b)%material_index)) then
+               fields = fields + 1
+               exit
+            end if
+         end do
+      end do
+   end function contact_field_count
 
    !> Refuse a scene whose particles cannot fit: more than a rank can count (default integers), or an
    !> estimate per rank (memory_estimate_per_rank, an even share) above what every rank has
