@@ -100,10 +100,10 @@ DISK_SPACING = 0.02    # cell size / particles per cell
 def contact_cases(quick):
     """(label, value, overrides) around the disks: E 1e6 Pa, v 1 m/s, mu 0.3."""
     ranges = {
-        # E >= 1e7 and v = 0.1 m/s gain kinetic energy through the contact and v = 50 m/s interpenetrates
-        # (docs/stability.md): in the whole suite, kept out of the quick one until the contact is fixed
-        "Young's modulus [Pa]": ("material youngs_modulus", [1.0e4, 1.0e8, 1.0e9] if not quick else []),
-        "speed [m/s]": ("body:rubber_a velocity", [0.1, 10.0, 50.0] if not quick else [10.0]),
+        # E = 1e8 Pa and v = 0.1 m/s once gained kinetic energy through the contact (docs/contact.md): in
+        # the quick subset as well; v = 50 m/s interpenetrates (docs/stability.md): the whole suite only
+        "Young's modulus [Pa]": ("material youngs_modulus", [1.0e4, 1.0e8, 1.0e9] if not quick else [1.0e8]),
+        "speed [m/s]": ("body:rubber_a velocity", [0.1, 10.0, 50.0] if not quick else [0.1, 10.0]),
         "friction": ("contact friction", [0.0, 1.0, 10.0] if not quick else [0.0, 10.0]),
     }
     cases = []

@@ -2,7 +2,7 @@
 """Contact between solid bodies by multiple velocity fields (issue 15 item 3, docs/contact.md):
 
   1. collision: two elastic blocks (scenes/contact/two_blocks.nml) meet head-on and part (the rebound
-     coefficient e = -(v_left - v_right) after / before is printed and must exceed 0.6: 0.70 in
+     coefficient e = -(v_left - v_right) after / before is printed and must exceed 0.6: 0.64 in
      docs/contact.md); the total momentum of the particles (fields files) is conserved to round-off
      (1e-12 of sum m |v|); the kinetic energy after the rebound is a fraction of the initial in [0.5, 1];
      the blocks never overlap by more than one cell (the gap between the particles' cells, from the
@@ -35,10 +35,15 @@
      table_by_slider, is minus the force on the stone, a block of a material in no &contact resting on
      the table (1e-9 of the peak); the stone, under the table's slip condition, does not move;
   8. two elastic disks (scenes/contact/two_disks.nml, Sulsky, Chen & Schreyer 1994 head-on, shape
-     'circle'): with &contact they part (rebound coefficient e > 0.6: 0.80 in docs/contact.md), total
-     momentum conserved to 1e-12 of sum m|v|, kinetic energy after in [0.5, 1] of the initial (0.73), no
+     'circle'): with &contact they part (rebound coefficient e > 0.6: 0.79 in docs/contact.md), total
+     momentum conserved to 1e-12 of sum m|v|, kinetic energy after in [0.5, 1] of the initial (0.71), no
      interpenetration beyond one cell along the line of centres; with one field the same run is checked
      for momentum and printed (they part too, e = 0.70: docs/contact.md);
+  8b. stiff disks (scenes/contact/stiff_disks.nml, the stability suite's oblique impact at E = 1e8 Pa,
+     where the impact once created kinetic energy, +65 %: docs/contact.md): the kinetic energy of
+     diagnostics.csv (every 5 ms) never exceeds its initial value by more than 1e-4 (the free flight
+     alone moves it by 7e-6, printed), the impact has happened (the right
+     disk moves) and the particles' momentum is conserved to 1e-12 of sum m|v|;
   9. the paper's floating block (inputs/floating_block.nml) with &contact between = 'block', 'block' (the
      block gets a field of its own, which touches no other body field) up to t = 0.5 s: bodies.csv,
      gauges.csv and diagnostics.csv byte for byte those of the scene without it, loads.csv to 1e-14 of
@@ -362,6 +367,32 @@ def check_disks(checks, flotsam, scenes):
                            f"{r['energy']:.3f}, smallest gap {r['gap'] * 1000:+.2f} mm (printed for docs/contact.md)")
 
 
+def check_stiff_disks(checks, flotsam, scenes):
+    template = os.path.join(scenes, "contact", "stiff_disks.nml")
+    if not run(checks, flotsam, template, "stiff_disks", 1):
+        return
+    directory = flotsam.path("stiff_disks")
+    rows = pd.read_csv(os.path.join(directory, "diagnostics.csv"), comment="#")
+    energy = rows["kinetic_energy"].to_numpy()
+    free = energy[rows["time"].to_numpy() < 0.05]     # in flight, before the disks share nodes (t ~ 0.06 s)
+    frame = bodies(directory)
+    speed = np.hypot(frame["right_vx"], frame["right_vy"]).iloc[-1]
+    # the disk in free flight trades 1e-5 of its kinetic energy with its elastic vibration (printed); the
+    # contact's fault added 65 % at the impact
+    checks.check(speed > 0.1 and len(energy) > 20 and energy.max() <= energy[0] * (1 + 1e-4),
+                 f"stiff disks (E = 1e8 Pa): the kinetic energy never rises above its initial {energy[0]:.4f} J "
+                 f"by more than 1e-4 over {len(energy)} rows: largest {energy.max():.4f} J (in free flight "
+                 f"{free.max() / energy[0] - 1:+.1e}), at the end {energy[-1]:.4f} J; the right disk hit, moving "
+                 f"at {speed:.3f} m/s")
+    states = fields(directory)
+    momentum = np.array([(s["m"][:, None] * s["v"]).sum(axis=0) for s in states])
+    scale = max((s["m"][:, None] * np.abs(s["v"])).sum() for s in states)
+    drift = np.abs(momentum - momentum[0]).max() / scale
+    checks.check(len(states) > 1 and drift <= 1e-12, f"stiff disks: particles' momentum conserved over {len(states)} "
+                                                     f"outputs to {drift:.1e} of sum m|v| (1e-12; the slip walls "
+                                                     "are not touched)")
+
+
 # --- 9: the paper's floating block with a field of its own ---------------------------------------------
 
 def check_floating_block(checks, flotsam, scenes):
@@ -449,6 +480,7 @@ def main():
     check_friction(checks, flotsam, scenes)
     check_structure_contact(checks, flotsam, scenes)
     check_disks(checks, flotsam, scenes)
+    check_stiff_disks(checks, flotsam, scenes)
     check_floating_block(checks, flotsam, scenes)
     return checks.summary()
 
