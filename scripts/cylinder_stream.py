@@ -25,25 +25,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from debris_column import read_csv  # noqa: E402
 SCENE = os.path.join(ROOT, "inputs", "cylinder_stream.nml")
 RHO, U, RADIUS = 1000.0, 1.0, 0.1      # the scene's density, inlet speed and cylinder radius
 
 
-def read_csv(path):
-    """Column name -> array of a Flotsam CSV (header row, then '#' comment lines, then rows)."""
-    with open(path) as f:
-        header = f.readline().strip().split(",")
-        rows = [line.split(",") for line in f if not line.startswith("#")]
-    data = np.array(rows, dtype=float)
-    return {name: data[:, i] for i, name in enumerate(header)}
-
-
 def wall_seconds(folder):
     """The run's wall time from run_summary.csv (its last row)."""
-    with open(os.path.join(folder, "run_summary.csv")) as f:
-        header = f.readline().strip().split(",")
-        rows = [line.strip().split(",") for line in f if not line.startswith("#")]
-    return float(rows[-1][header.index("wall_seconds")])
+    return float(read_csv(os.path.join(folder, "run_summary.csv"))["wall_seconds"][-1])
 
 
 def run(flotsam, ranks, cell, folder):

@@ -31,6 +31,7 @@ import sys
 import h5py
 import matplotlib
 import numpy as np
+import pandas
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -41,12 +42,8 @@ from scene_variant import _group_end  # noqa: E402
 
 
 def read_csv(path):
-    """Column name -> array of a Flotsam CSV (header row, then '#' comment lines, then rows)."""
-    with open(path) as f:
-        header = f.readline().strip().split(",")
-        rows = [line.split(",") for line in f if not line.startswith("#")]
-    data = np.array(rows, dtype=float)
-    return {name: data[:, i] for i, name in enumerate(header)}
+    """Column name -> numpy array of a Flotsam CSV (docs/output.md: one pandas call reads it)."""
+    return {name: column.to_numpy() for name, column in pandas.read_csv(path, comment="#").items()}
 
 
 def column_box(folder):

@@ -82,13 +82,7 @@ contains
       lattice%whole = lattice%shape%kind == shape_box .and. .not. abs(lattice%shape%rotation) > 0.0_rp
       if (lattice%whole) then
          ! the lattice of the box itself: the same expressions as before shapes, so the same particles
-         if (box_corners_given(body, dim)) then
-            lo = body%lower
-            hi = body%upper
-         else
-            lo = lattice%shape%centre - 0.5_rp * lattice%shape%size
-            hi = lattice%shape%centre + 0.5_rp * lattice%shape%size
-         end if
+         call body_bounds_of_box(body, dim, lo, hi)
          lattice%n(1:dim) = nint((hi(1:dim) - lo(1:dim)) / (grid%cell_size / body%particles_per_cell))
          lattice%lower = lo
          lattice%spacing(1:dim) = (hi(1:dim) - lo(1:dim)) / lattice%n(1:dim)
