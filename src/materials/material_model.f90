@@ -14,7 +14,6 @@ module material_model
    contains
       procedure(update_stress_interface), deferred :: update_stress
       procedure(wave_speed_interface), deferred :: wave_speed
-      procedure :: max_signal_speed => model_max_signal_speed
    end type material_model_t
 
    abstract interface
@@ -46,21 +45,6 @@ module material_model
    public :: volume_ratio_increment
 
 contains
-
-   !> Bound on max_p (c(rho_p) + |v_p|) over a slice, the signal speed of the CFL condition:
-   !> c(min rho) + max |v|. The wave speed of every model falls with density, so this bound is safe
-   !> (at most the sum of two maxima) and costs one model call per slice.
-   pure real(rp) function model_max_signal_speed(self, density, velocity) result(speed)
-      class(material_model_t), intent(in) :: self
-      real(rp), intent(in) :: density(:), velocity(:, :)
-      integer :: p
-      real(rp) :: speed2
-      speed2 = 0.0_rp
-      do p = 1, size(density)
-         speed2 = max(speed2, sum(velocity(:, p)**2))
-      end do
-      speed = self%wave_speed(minval(density)) + sqrt(speed2)
-   end function model_max_signal_speed
 
    !> det(I + dt d): ratio of new to old volume over one step (algorithms.md section 5.1).
    pure real(rp) function volume_ratio_increment(dim, dt, d)

@@ -598,61 +598,86 @@ contains
    end subroutine remap_velocities
 
    !> dt = CFL h / (sqrt(dim) max_p (c_p + |v_p|)), limited by the viscous step CFL rho h^2 / (2 dim mu)
-   !> (algorithms.md section 5.4), or the fixed dt of &run. Collective (global minimum).
+   !> (algorithms.md section 5.4), or the fixed dt of &run. Collective (global maxima of the speeds).
    real(rp) function solver_stable_time_step(self) result(dt)
       class(solver_t), intent(inout) :: self
-      real(rp) :: speed
-      call local_time_step(self, dt, speed)
-      call MPI_Allreduce(MPI_IN_PLACE, dt, 1, MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
+      real(rp) :: speeds(2 * size(self%materials)), speed
+      call local_speeds(self, speeds)
+      speeds = -speeds
+      call MPI_Allreduce(MPI_IN_PLACE, speeds, size(speeds), MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
+      call time_step_of_speeds(self, -speeds, dt, speed)
    end function solver_stable_time_step
 
-   !> This rank's stable step (see solver_stable_time_step) and a bound `speed` [m/s] on how fast its
-   !> particles move: the largest signal speed c + |v| of its particles and open inlets, or with a fixed
-   !> step a bound on the largest |v| (the sound speed is not needed then, and a blowing-up state may
-   !> have no valid one). An inlet that is not closed yet counts as a particle of its fluid at rho0 moving at
-   !> v0: the step must resolve the fluid it is about to create (and an empty tank must not take a huge
-   !> step).
-   subroutine local_time_step(self, dt, speed)
+   !> This rank's part of the step's bound, per material m: speeds(2 m - 1) the wave speed at the lowest
+   !> density of its particles here, speeds(2 m) their largest |v| (with a fixed step: sqrt(dim) max |v_k|,
+   !> no squares that could overflow in a blowing-up state); 0 without particles. Every model's wave speed
+   !> falls with density, so c(rho_min) + max |v| bounds c_p + |v_p| at one model call. The two are reduced
+   !> apart (a maximum each over the ranks): c(rho_min) + max |v| of the whole material is then the same
+   !> number on any rank count, which the largest per-rank sum c + |v| is not (the slowest density and the
+   !> fastest particle may lie on different ranks).
+   subroutine local_speeds(self, speeds)
       type(solver_t), intent(in) :: self
+      real(rp), intent(out) :: speeds(:)
+      integer :: m, first, last, p
+      real(rp) :: speed2
+      speeds = 0.0_rp
+      do m = 1, size(self%materials)
+         first = self%particles%material_first(m)
+         last = self%particles%material_last(m)
+         if (last < first) cycle
+         if (self%run%fixed_dt > 0.0_rp) then
+            speeds(2 * m) = sqrt(real(self%grid%dim, rp)) * maxval(abs(self%particles%v(:, first:last)))
+         else
+            speed2 = 0.0_rp
+            do p = first, last
+               speed2 = max(speed2, sum(self%particles%v(:, p)**2))
+            end do
+            speeds(2 * m - 1) = self%materials(m)%model%wave_speed(minval(self%particles%density(first:last)))
+            speeds(2 * m) = sqrt(speed2)
+         end if
+      end do
+   end subroutine local_speeds
+
+   !> The stable step `dt` from the speeds of all ranks (local_speeds, reduced), and a bound `speed`
+   !> [m/s] on how fast the particles move: the largest signal speed c + |v| of the materials and open
+   !> inlets, or with a fixed step a bound on the largest |v| (the sound speed is not needed then, and a
+   !> blowing-up state may have no valid one). An inlet that is not closed yet counts as a particle of its
+   !> fluid at rho0 moving at v0: the step must resolve the fluid it is about to create (and an empty tank
+   !> must not take a huge step).
+   subroutine time_step_of_speeds(self, speeds, dt, speed)
+      type(solver_t), intent(in) :: self
+      real(rp), intent(in) :: speeds(:)
       real(rp), intent(out) :: dt, speed
-      integer :: m, first, last, i, n
-      n = self%particles%count
+      integer :: m, i
+      speed = 0.0_rp
+      do m = 1, size(self%materials)
+         speed = max(speed, speeds(2 * m - 1) + speeds(2 * m))
+      end do
       if (self%run%fixed_dt > 0.0_rp) then
          dt = self%run%fixed_dt
-         speed = 0.0_rp
-         ! sqrt(dim) max |v_k| >= |v|, without squares that could overflow in a blowing-up state
-         if (n > 0) speed = sqrt(real(self%grid%dim, rp)) * maxval(abs(self%particles%v(:, 1:n)))
          do i = 1, size(self%inlets)
             if (self%time < self%inlets(i)%spec%end_time) speed = max(speed, self%inlets(i)%spec%velocity)
          end do
          return
       end if
-      speed = 0.0_rp
       dt = huge(1.0_rp)
-      do m = 1, size(self%materials)
-         first = self%particles%material_first(m)
-         last = self%particles%material_last(m)
-         if (last >= first) speed = max(speed, self%materials(m)%model%max_signal_speed( &
-                                         self%particles%density(first:last), self%particles%v(:, first:last)))
-      end do
       do i = 1, size(self%inlets)
          associate (spec => self%inlets(i)%spec)
             if (self%time >= spec%end_time) cycle
-            speed = max(speed, self%materials(spec%material_index)%model%max_signal_speed( &
-                        [self%inlets(i)%density], reshape(spec%velocity * spec%direction(1:self%grid%dim), &
-                                                          [self%grid%dim, 1])))
+            speed = max(speed, self%materials(spec%material_index)%model%wave_speed(self%inlets(i)%density) &
+                        + sqrt(sum((spec%velocity * spec%direction(1:self%grid%dim))**2)))
          end associate
       end do
       if (speed > 0.0_rp) dt = self%run%cfl * self%grid%h / (sqrt(real(self%grid%dim, rp)) * speed)
       dt = min(dt, viscous_time_step(self))
-   end subroutine local_time_step
+   end subroutine time_step_of_speeds
 
    !> The next time step, and a new layout if the particles outgrew the active region or it became too big
    !> for them (active_region). One reduction for both: the step, the largest signal speed and the
    !> particles' extent travel together (there is no other reduction per step for the box). Collective.
    subroutine follow_particles(self)
       type(solver_t), intent(inout) :: self
-      real(rp) :: values(8), speed
+      real(rp) :: values(6 + 2 * size(self%materials)), speed
       integer :: dim, need_lo(3), need_hi(3), box_lo(3), box_hi(3), target_lo(3), target_hi(3), guard, margin
       integer :: cuts(0:self%domain%nranks, 3)
       integer(i8) :: largest
@@ -660,20 +685,19 @@ contains
       type(status_t) :: status
 
       dim = self%grid%dim
-      ! all as minima: [dt, -speed, lo(1:3), -hi(1:3)]. The extent is that of the positions the step
-      ! computed (no pass of its own): the safeguard then moves particles only back behind walls, by less
-      ! than the step's travel, and inlets inject into their openings, which the region covers anyway.
-      call local_time_step(self, values(1), speed)
-      values(2) = -speed
-      values(3:5) = self%extent(:, 1)
-      values(6:8) = -self%extent(:, 2)
+      ! all as minima: [lo(1:3), -hi(1:3), -speeds(:)] (local_speeds). The extent is that of the positions
+      ! the step computed (no pass of its own): the safeguard then moves particles only back behind walls,
+      ! by less than the step's travel, and inlets inject into their openings, which the region covers.
+      values(1:3) = self%extent(:, 1)
+      values(4:6) = -self%extent(:, 2)
+      call local_speeds(self, values(7:))
+      values(7:) = -values(7:)
       call MPI_Allreduce(MPI_IN_PLACE, values, size(values), MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
-      self%dt = values(1)
-      speed = -values(2)
+      call time_step_of_speeds(self, -values(7:), self%dt, speed)
 
       ! a state that is no longer finite is the health check's business, not the layout's
       if (.not. all(ieee_is_finite(values))) return
-      call needed_cells(self, values(3:5), -values(6:8), need_lo, need_hi)
+      call needed_cells(self, values(1:3), -values(4:6), need_lo, need_hi)
       guard = guard_cells(self%dt * speed * self%grid%inv_h)
       margin = guard + slack_cells
       call target_box(need_lo, need_hi, margin, self%grid%global_cells, dim, target_lo, target_hi)
