@@ -33,9 +33,9 @@ contains
       class(node_based_anti_locking_t), intent(inout) :: self
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
-      real(rp) :: xi(3), gradients(3, 27)
+      real(rp) :: xi(3)
       integer :: p, q, a, c(3), first, last, dim, k
-      real(rp), allocatable :: mass(:, :)
+      real(rp), allocatable :: mass(:, :), gradients(:, :)
 
       associate (grid => context%grid)
          dim = grid%dim
@@ -43,7 +43,7 @@ contains
          last = context%last
          if (allocated(self%base)) deallocate (self%base, self%weight)
          allocate (self%base(max(0, last - first + 1)), self%weight(grid%stencil_size, max(0, last - first + 1)))
-         allocate (mass(1, grid%node_count))
+         allocate (mass(1, grid%node_count), gradients(dim, grid%stencil_size))
          mass = 0.0_rp
          do p = first, last
             q = p - first + 1
@@ -54,8 +54,7 @@ contains
             end do
             self%base(q) = grid%local_node(c)
             xi(1:dim) = xi(1:dim) - c(1:dim)
-            call stencil_values(grid%shape, dim, xi(1:dim), grid%inv_h, self%weight(:, q), &
-                                gradients(1:dim, 1:grid%stencil_size))
+            call stencil_values(grid%shape, dim, xi(1:dim), grid%inv_h, self%weight(:, q), gradients)
             do a = 1, grid%stencil_size
                associate (node => self%base(q) + grid%stencil_stride(a))
                   mass(1, node) = mass(1, node) + self%weight(a, q) * particles%mass(p)
