@@ -144,7 +144,7 @@ contains
       end do
    end subroutine test_bspline2_patch
 
-   !> The 1-D quadratic B-spline of [SKB08] eq. 20 at known points: a particle on a node gives 1/8, 3/4, 1/8;
+   !> The 1-D quadratic B-spline of [SKB08] at known points: a particle on a node gives 1/8, 3/4, 1/8;
    !> halfway between two nodes 1/2, 1/2, 0 (the stencil centred on the lower one); the value is C1 across
    !> the switch of the nearest node (the values of a node agree from both sides).
    subroutine test_bspline2_support()
