@@ -172,8 +172,12 @@ def check_hydrostatic_3d(checks, flotsam, scenes, shape="linear"):
     close(checks, mean["y_min_fy"], -per_width * width_x, 0.01, f"{name}: y_min fy = -rho g H^2/2 * 0.4 m")
     close(checks, mean["y_max_fy"], per_width * width_x, 0.01, f"{name}: y_max fy")
     close(checks, mean["z_min_fz"], -weight, 0.005, f"{name}: floor fz = -weight")
-    close(checks, mean["x_min_my"], -moment_per_width * width_y, 0.02, f"{name}: x_min my about the origin")
-    close(checks, mean["y_min_mx"], moment_per_width * width_x, 0.02, f"{name}: y_min mx about the origin")
+    # bspline2 spreads a wall's load over 3 node layers, the lowest a ghost layer below the floor (arm -h): at
+    # 6 cells over H the moments about the foot come out 3-4 % low (measured 3.2 % and 4.2 %), the forces
+    # within 1 %; its own tolerance, stated in docs/theory.md section 1.1 and docs/loads.md
+    moment_tolerance = 0.02 if shape == "linear" else 0.05
+    close(checks, mean["x_min_my"], -moment_per_width * width_y, moment_tolerance, f"{name}: x_min my about the origin")
+    close(checks, mean["y_min_mx"], moment_per_width * width_x, moment_tolerance, f"{name}: y_min mx about the origin")
     close(checks, mean["x_min_mz"], per_width * width_y * width_y / 2, 0.01, f"{name}: x_min mz about the origin")
 
 
