@@ -79,6 +79,15 @@ module boundary_walls
 
 contains
 
+   !> How far behind a wall its constraint acts, in cells: depth_in_cells, or with a stencil reaching 1.5 h
+   !> from the particle per axis (bspline2) 1.5 sqrt(dim), the farthest a node it touches can lie behind a
+   !> wall the particle is in front of (2.1 h in 2-D, 2.6 h in 3-D; docs/theory.md section 1.1) [R].
+   pure real(rp) function wall_depth_in_cells(grid) result(depth)
+      type(grid_t), intent(in) :: grid
+      depth = depth_in_cells
+      if (grid%ghost > 0) depth = max(depth_in_cells, 1.5_rp * sqrt(real(grid%dim, rp)))
+   end function wall_depth_in_cells
+
    !> The walls of `&wall` groups (`specs`) and of the `&box_walls` sides of `spec`, with their local nodes.
    subroutine build_walls(specs, spec, grid, walls)
       type(wall_spec_t), intent(in) :: specs(:)
@@ -150,7 +159,7 @@ contains
       wall%kind = kind
       wall%friction = friction
       wall%load = load
-      wall%depth = depth_in_cells * grid%h
+      wall%depth = wall_depth_in_cells(grid) * grid%h
       wall%moment_point = 0.0_rp
       wall%moment_point(1:dim) = grid%frame%grid_point(moment_point(1:dim))
       ! the grid-frame box of the world box's corners holds the shape
@@ -246,7 +255,7 @@ contains
       wall%lower = lower
       wall%upper = upper
       wall%margin = margin
-      wall%depth = depth_in_cells * grid%h
+      wall%depth = wall_depth_in_cells(grid) * grid%h
       wall%kind = kind
       if (present(velocity)) wall%velocity(1:dim) = grid%frame%grid_vector(velocity(1:dim))
       if (present(active_from)) wall%active_from = active_from

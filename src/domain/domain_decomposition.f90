@@ -17,7 +17,8 @@ module domain_decomposition
 
    integer, parameter :: max_cuts = 4096
 
-   !> Fewest cell layers in a slab of a split axis: the smoothing's cell halo is two layers deep.
+   !> Fewest cell layers in a slab of a split axis: the smoothing's cell halo is two layers deep. A wider
+   !> shape function may ask for more (domain_t%min_width).
    integer, parameter, public :: min_slab_width = 2
 
    public :: layout_dims, valid_layout, fit_box, uniform_cuts
@@ -32,6 +33,9 @@ module domain_decomposition
       integer :: global_cells(3) = 1              !< cells of the whole grid along each axis
       integer, allocatable :: cuts(:, :)          !< (0:nranks, axis) first cell of each slab, region end, 0s
       integer :: cell_lo(3) = 0, cell_hi(3) = 0   !< owned cells, global 0-based inclusive
+      !> fewest cells of a slab on a split axis (set before init): 3 with bspline2, whose node halo is 3
+      !> layers deep, so that a node is only ever shared by face neighbours (node_halo)
+      integer :: min_width = min_slab_width
    contains
       procedure :: init => domain_init
       procedure :: free => domain_free
@@ -80,9 +84,10 @@ contains
          self%dims(order(k)) = dims(k)
       end do
       do k = 1, dim
-         if (self%dims(k) > 1 .and. min_slab_width * self%dims(k) > global_cells(k)) then
-            write (msg, '(a,i0,a,i0,a,i0,a)') 'cannot split ', global_cells(k), ' cells along axis ', k, &
-               ' over ', self%dims(k), ' ranks (at least 2 cells per rank): use fewer ranks or a finer grid'
+         if (self%dims(k) > 1 .and. self%min_width * self%dims(k) > global_cells(k)) then
+            write (msg, '(a,i0,a,i0,a,i0,a,i0,a)') 'cannot split ', global_cells(k), ' cells along axis ', k, &
+               ' over ', self%dims(k), ' ranks (at least ', self%min_width, &
+               ' cells per rank): use fewer ranks or a finer grid'
             call status%fail(trim(msg))
             return
          end if
@@ -96,18 +101,21 @@ contains
       ! cuts has room for any rank grid: its size depends on the number of ranks alone
       if (allocated(self%cuts)) deallocate (self%cuts)
       allocate (self%cuts(0:self%nranks, 3))
-      call fit_box(self%dims, global_cells, lo, hi)
+      call fit_box(self%dims, global_cells, lo, hi, self%min_width)
       call self%set_cuts(uniform_cuts(self%dims, lo, hi, self%nranks))
    end subroutine domain_init
 
    !> Widen lo..hi (global cells, inclusive) inside the grid until every axis has room for dims(k) slabs
-   !> (min_slab_width cells each on a split axis): cells are added on both sides in turn.
-   pure subroutine fit_box(dims, global_cells, lo, hi)
+   !> (min_width cells each on a split axis, default min_slab_width): cells are added on both sides in turn.
+   pure subroutine fit_box(dims, global_cells, lo, hi, min_width)
       integer, intent(in) :: dims(3), global_cells(3)
       integer, intent(inout) :: lo(3), hi(3)
-      integer :: k, width
+      integer, intent(in), optional :: min_width
+      integer :: k, width, least
+      least = min_slab_width
+      if (present(min_width)) least = min_width
       do k = 1, 3
-         width = dims(k) * merge(min_slab_width, 1, dims(k) > 1)
+         width = dims(k) * merge(least, 1, dims(k) > 1)
          do while (hi(k) - lo(k) + 1 < width)
             if (lo(k) > 0) lo(k) = lo(k) - 1
             if (hi(k) - lo(k) + 1 < width .and. hi(k) < global_cells(k) - 1) hi(k) = hi(k) + 1
@@ -153,7 +161,7 @@ contains
       kept = .true.
       do k = 1, 3
          d = self%dims(k)
-         width = merge(min_slab_width, 1, d > 1)
+         width = merge(self%min_width, 1, d > 1)
          cuts(0, k) = lo(k)
          cuts(d, k) = hi(k) + 1
          if (d > 1) then
@@ -217,11 +225,14 @@ contains
 
    !> True if `cuts` is a layout of `nranks` ranks over `global_cells`: along each of the first `dim`
    !> axes slabs ascending inside the grid (an active region, not necessarily the whole grid), at least
-   !> min_slab_width cells wide on a split axis, the product of the slab counts nranks, and zeros after
-   !> the last cut; the unused axes one cell.
-   pure logical function valid_layout(cuts, global_cells, dim, nranks) result(valid)
+   !> min_width (default min_slab_width) cells wide on a split axis, the product of the slab counts nranks,
+   !> and zeros after the last cut; the unused axes one cell.
+   pure logical function valid_layout(cuts, global_cells, dim, nranks, min_width) result(valid)
       integer, intent(in) :: cuts(0:, :), global_cells(3), dim, nranks
-      integer :: dims(3), k
+      integer, intent(in), optional :: min_width
+      integer :: dims(3), k, least
+      least = min_slab_width
+      if (present(min_width)) least = min_width
       valid = size(cuts, 1) == nranks + 1 .and. size(cuts, 2) == 3
       if (.not. valid) return
       dims = layout_dims(cuts)
@@ -230,7 +241,7 @@ contains
       do k = 1, 3
          valid = valid .and. cuts(0, k) >= 0 .and. cuts(dims(k), k) <= global_cells(k) .and. &
                  all(cuts(dims(k) + 1:, k) == 0)
-         if (dims(k) > 1) valid = valid .and. all(cuts(1:dims(k), k) - cuts(0:dims(k) - 1, k) >= min_slab_width)
+         if (dims(k) > 1) valid = valid .and. all(cuts(1:dims(k), k) - cuts(0:dims(k) - 1, k) >= least)
       end do
    end function valid_layout
 

@@ -1,5 +1,7 @@
 !> The part of the background grid a rank works on: the nodes of its owned cells.
 !>
+!> The local nodes are those of the owned cells and, with a stencil wider than a cell's corners (bspline2),
+!> `ghost` more layers on each side (shape_functions: ghost_node_layers); node_lo = cell_lo - ghost.
 !> Nodes are numbered locally in one flat index, x fastest:
 !>   node(i, j, k) = 1 + (i - node_lo(1)) + n_nodes(1) * ((j - node_lo(2)) + n_nodes(2) * (k - node_lo(3)))
 !> with global 0-based node indices i, j, k. Cells use the same rule with their own counts. Nodal
@@ -10,7 +12,7 @@ module background_grid
    use error_status, only: status_t
    use memory_budget, only: byte_text
    use input_text, only: int_text
-   use shape_functions, only: n_corners, corner_offset
+   use shape_functions, only: shape_linear, stencil_nodes, stencil_offset, ghost_node_layers
    use domain_decomposition, only: domain_t
    use world_frame, only: frame_t
    implicit none
@@ -30,9 +32,14 @@ module background_grid
       integer :: n_nodes(3) = 1, node_count = 0
       integer :: cell_lo(3) = 0, cell_hi(3) = 0    !< owned cells (global, 0-based)
       integer :: n_cells(3) = 1, cell_count = 0
-      integer :: corner_stride(8) = 0              !< local node offset of corner a from the cell's lower node
-      !> along axis k the rank's cells end where the active region does: it owns its upper node layer too
+      integer :: shape = shape_linear               !< shape function kind (set before init, kept by init)
+      integer :: ghost = 0                          !< node layers beyond the cells' corners on each side
+      integer :: stencil_size = 4                   !< nodes a particle touches (shape_functions: stencil_nodes)
+      integer :: stencil_stride(27) = 0             !< local node offset of stencil node a from the base node
+      !> along axis k the rank's cells end where the active region does: it owns its upper node layers too
       logical :: owns_upper(3) = .true.
+      !> along axis k the rank's cells start where the active region does: it owns its lower ghost layers
+      logical :: owns_lower(3) = .true.
       integer :: row_momentum = 2, row_force = 4, n_rows = 5
       integer :: field_rows = 0                    !< rows of the contact fields after the force (kept by init)
       real(rp), allocatable :: accumulated(:, :)   !< (n_rows, node): mass, momentum, force
@@ -70,26 +77,31 @@ contains
       self%cell_lo = domain%cell_lo
       self%cell_hi = domain%cell_hi
       self%owns_upper = .true.
+      self%owns_lower = .true.
       if (allocated(domain%cuts)) then
          do k = 1, self%dim
             self%owns_upper(k) = domain%cell_hi(k) == domain%cuts(domain%dims(k), k) - 1
+            self%owns_lower(k) = domain%cell_lo(k) == domain%cuts(0, k)
          end do
       end if
+      self%ghost = ghost_node_layers(self%shape)
       self%n_cells = 1
       self%n_cells(1:self%dim) = self%cell_hi(1:self%dim) - self%cell_lo(1:self%dim) + 1
       self%cell_count = product(self%n_cells)
       self%node_lo = self%cell_lo
       self%node_hi = self%cell_hi
-      self%node_hi(1:self%dim) = self%cell_hi(1:self%dim) + 1
+      self%node_lo(1:self%dim) = self%cell_lo(1:self%dim) - self%ghost
+      self%node_hi(1:self%dim) = self%cell_hi(1:self%dim) + 1 + self%ghost
       self%n_nodes = 1
-      self%n_nodes(1:self%dim) = self%n_cells(1:self%dim) + 1
+      self%n_nodes(1:self%dim) = self%n_cells(1:self%dim) + 1 + 2 * self%ghost
       self%node_count = product(self%n_nodes)
 
       stride = [1, self%n_nodes(1), self%n_nodes(1) * self%n_nodes(2)]
-      self%corner_stride = 0
-      do a = 1, n_corners(self%dim)
+      self%stencil_size = stencil_nodes(self%shape, self%dim)
+      self%stencil_stride = 0
+      do a = 1, self%stencil_size
          do k = 1, self%dim
-            self%corner_stride(a) = self%corner_stride(a) + corner_offset(a, k) * stride(k)
+            self%stencil_stride(a) = self%stencil_stride(a) + stencil_offset(self%shape, a, k) * stride(k)
          end do
       end do
 
@@ -140,7 +152,8 @@ contains
    end function grid_node_indices
 
    !> True if this rank is the one that counts the local node g (global indices) in sums over nodes: a
-   !> node shared with the rank above along an axis belongs to that rank (the lower corner of its cells).
+   !> node shared with the rank above along an axis belongs to that rank (the lower corner of its cells),
+   !> a ghost node below the rank's cells to the rank below.
    pure logical function grid_owns_node(self, g) result(owns)
       class(grid_t), intent(in) :: self
       integer, intent(in) :: g(:)
@@ -148,6 +161,7 @@ contains
       owns = .true.
       do k = 1, self%dim
          if (g(k) > self%cell_hi(k) .and. .not. self%owns_upper(k)) owns = .false.
+         if (g(k) < self%cell_lo(k) .and. .not. self%owns_lower(k)) owns = .false.
       end do
    end function grid_owns_node
 
@@ -163,7 +177,7 @@ contains
       grid_local_cell = grid_local_cell + 1
    end function grid_local_cell
 
-   !> Local index of the lower corner node of the cell with global indices c.
+   !> Local index of the lower corner node of the cell with global indices c (in the local node box).
    pure integer function grid_base_node_of_cell(self, c)
       class(grid_t), intent(in) :: self
       integer, intent(in) :: c(:)

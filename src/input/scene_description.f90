@@ -64,6 +64,8 @@ module scene_description
       real(rp) :: origin(3) = 0.0_rp          !< lower corner of the scene box (world frame) [m]
       real(rp) :: extent(3) = 0.0_rp          !< edge lengths of the scene box [m], whole multiples of cell_size
       real(rp) :: rotation = 0.0_rp           !< grid rotation theta_g, counter-clockwise about z [degrees]
+      !> 'linear' (multilinear, 2**dim nodes per particle) or 'bspline2' (quadratic B-spline, 3**dim nodes)
+      character(len=name_len) :: shape_function = 'linear'
       integer :: ncells(3) = 1                !< derived: extent / cell_size (1 on unused axes)
       !> wall condition per side: (1, k) lower side, (2, k) upper side of axis k
       character(len=name_len) :: wall(2, 3) = wall_none

@@ -90,6 +90,7 @@ module scene_reader
       variable_info_t('grid', 'origin', 'real3', .false.), &
       variable_info_t('grid', 'extent', 'real3', .true.), &
       variable_info_t('grid', 'rotation', 'real', .false.), &
+      variable_info_t('grid', 'shape_function', 'string', .false.), &
       variable_info_t('box_walls', 'x_min', 'string', .false.), &
       variable_info_t('box_walls', 'x_max', 'string', .false.), &
       variable_info_t('box_walls', 'y_min', 'string', .false.), &
@@ -937,13 +938,15 @@ contains
       character(len=*), intent(in) :: text
       integer :: dim
       real(rp) :: cell_size, origin(3), extent(3), rotation
-      namelist /grid/ dim, cell_size, origin, extent, rotation
+      character(len=text_len) :: shape_function
+      namelist /grid/ dim, cell_size, origin, extent, rotation, shape_function
 
       dim = spec%dim
       cell_size = spec%cell_size
       origin = spec%origin
       extent = spec%extent
       rotation = spec%rotation
+      shape_function = spec%shape_function
       read (text, nml=grid, iostat=ios, iomsg=message)
       if (ios /= 0) return
       spec%dim = dim
@@ -951,6 +954,7 @@ contains
       spec%origin = origin
       spec%extent = extent
       spec%rotation = rotation
+      call take_text('shape_function', shape_function, spec%shape_function, ios, message, fold='lower')
    end subroutine read_grid_group
 
    subroutine read_box_walls_group(spec, ios, message, text)

@@ -186,6 +186,8 @@ contains
             text = reals(grid%extent)
          case ('rotation')
             text = real_text(grid%rotation)
+         case ('shape_function')
+            text = quoted(grid%shape_function)
          case default
             text = ''
          end select

@@ -46,6 +46,8 @@ module scene_validation
    !> Above this shifting coefficient the explicit occupancy diffusion is no longer stable (2-D bilinear
    !> grid Laplacian, docs/volume-conservation.md).
    real(rp), parameter :: max_shifting_coefficient = 0.25_rp
+   !> Accepted `&grid shape_function=` keywords (stored lower case; docs/theory.md section 1.1).
+   character(len=*), parameter, public :: shape_function_keywords(*) = [character(len=8) :: 'linear', 'bspline2']
    !> Accepted `&run update_scheme=` keywords (stored upper case).
    character(len=*), parameter, public :: update_scheme_keywords(*) = [character(len=4) :: 'USL', 'MUSL']
    !> Accepted `&box_walls` keywords (stored lower case).
@@ -105,6 +107,8 @@ contains
       if (.not. status%ok) return
       do m = 1, size(scene%materials)
          call validate_material(scene%materials, m, path, status)
+         if (.not. status%ok) return
+         call check_shape_function_combination(scene%materials(m), m, scene%grid, path, status)
          if (.not. status%ok) return
       end do
 
@@ -599,6 +603,10 @@ contains
          call check_real(where, 'extent('//int_text(k)//')', grid%extent(k), status, greater_than=0.0_rp)
       end do
       call check_real(where, 'rotation', grid%rotation, status, at_least=-360.0_rp, at_most=360.0_rp)
+      if (all(grid%shape_function /= shape_function_keywords)) then
+         call status%fail(where//': variable shape_function must be one of '//quoted_list(shape_function_keywords)// &
+                          ", got '"//trim(grid%shape_function)//"'")
+      end if
       if (.not. status%ok) return
 
       total_cells = 1.0_rp
@@ -677,6 +685,22 @@ contains
          call check_real(group_context(path, 'gravity', 0), 'acceleration('//int_text(k)//')', gravity(k), status)
       end do
    end subroutine validate_gravity
+
+   !> The schemes of a material that a shape function does not combine with (docs/theory.md section 1.1):
+   !> the volume correction's occupancy and open volumes integrate the multilinear hat of a node over its
+   !> two cells, which bspline2 replaces by a wider support [R].
+   subroutine check_shape_function_combination(material, m, grid, path, status)
+      type(material_spec_t), intent(in) :: material
+      integer, intent(in) :: m
+      type(grid_spec_t), intent(in) :: grid
+      character(len=*), intent(in) :: path
+      type(status_t), intent(inout) :: status
+      if (grid%shape_function == 'linear') return
+      if (material%volume_correction /= 'none') &
+         call status%fail(group_context(path, 'material', m, "name '"//trim(material%name)//"'")// &
+                          ": variable volume_correction = '"//trim(material%volume_correction)// &
+                          "' needs &grid shape_function = 'linear', got '"//trim(grid%shape_function)//"'")
+   end subroutine check_shape_function_combination
 
    subroutine validate_material(materials, m, path, status)
       type(material_spec_t), intent(in) :: materials(:)

@@ -372,7 +372,8 @@ contains
          call file%read_attribute('cuts', state%cuts, status)
          if (status%ok) then
             if (.not. valid_layout(reshape(state%cuts, shape(solver%domain%cuts)), solver%domain%global_cells, &
-                                   solver%domain%dim, n_ranks)) call status%fail(where//' has an invalid decomposition')
+                                   solver%domain%dim, n_ranks, solver%domain%min_width)) &
+               call status%fail(where//' has an invalid decomposition')
          end if
          slab = slab_t(sum(state%rank_counts(1:rank)), state%rank_counts(rank + 1), state%total)
       else

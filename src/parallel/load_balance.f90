@@ -55,11 +55,15 @@ contains
    end function split_counts
 
    !> The rank grids dims(1:3) with product nranks (1 beyond `dim`) in which every split axis has at
-   !> least min_slab_width cells per slab (of `cells` along each axis), as columns of grids(3, :).
-   pure function rank_grids(nranks, dim, cells) result(grids)
+   !> least min_width (default min_slab_width) cells per slab (of `cells` along each axis), as columns of
+   !> grids(3, :).
+   pure function rank_grids(nranks, dim, cells, min_width) result(grids)
       integer, intent(in) :: nranks, dim, cells(3)
+      integer, intent(in), optional :: min_width
       integer, allocatable :: grids(:, :)
-      integer :: a, b, c
+      integer :: a, b, c, least
+      least = min_slab_width
+      if (present(min_width)) least = min_width
       allocate (grids(3, 0))
       do a = 1, nranks
          if (mod(nranks, a) /= 0 .or. .not. fits(a, 1)) cycle
@@ -73,7 +77,7 @@ contains
    contains
       pure logical function fits(d, k)
          integer, intent(in) :: d, k
-         fits = d == 1 .or. min_slab_width * d <= cells(k)
+         fits = d == 1 .or. least * d <= cells(k)
       end function fits
    end function rank_grids
 
@@ -111,7 +115,7 @@ contains
       end do
       call MPI_Allreduce(MPI_IN_PLACE, histogram, size(histogram), MPI_INTEGER8, MPI_SUM, domain%comm)
 
-      grids = rank_grids(domain%nranks, domain%dim, n)
+      grids = rank_grids(domain%nranks, domain%dim, n, domain%min_width)
       allocate (candidate_cuts(0:domain%nranks, 3, size(grids, 2)), loads(0:domain%nranks - 1, size(grids, 2)))
       candidate_cuts = 0
       loads = 0
@@ -120,7 +124,7 @@ contains
          do k = 1, 3
             associate (d => grids(k, g))
                candidate_cuts(0:d, k, g) = split_counts(histogram(first(k) + 1:first(k) + n(k)), d, &
-                                                         merge(1, min_slab_width, d == 1))
+                                                         merge(1, domain%min_width, d == 1))
                ! slab of every layer, then the box of every particle: slab_1 + d_1 (slab_2 + d_2 slab_3)
                do box = 0, d - 1
                   slab(candidate_cuts(box, k, g):candidate_cuts(box + 1, k, g) - 1, k) = box

@@ -1,9 +1,12 @@
 !> Ghost-node summation: nodes on the boundary between two ranks' cell boxes receive particle
 !> contributions on both ranks; afterwards each rank must hold the full sum.
 !>
-!> One axis at a time, each rank packs its two boundary node planes (whole local extent of the other
-!> axes) into contiguous buffers, exchanges them with both face neighbours and adds what it receives.
-!> Axis by axis, edge and corner nodes pick up the sums of all 2**dim ranks that share them.
+!> One axis at a time, each rank packs its boundary node planes (whole local extent of the other axes)
+!> into contiguous buffers, exchanges them with both face neighbours and adds what it receives. Axis by
+!> axis, edge and corner nodes pick up the sums of all 2**dim ranks that share them. Neighbours share
+!> 1 + 2 ghost planes: the plane of their common cell face and the grid's ghost layers on both sides of it
+!> (bspline2: 3 planes). A slab is at least that many cells wide (domain_t%min_width), so only face
+!> neighbours share a plane.
 module node_halo
    use kinds, only: rp
    use mpi_f08, only: MPI_PROC_NULL
@@ -23,23 +26,31 @@ contains
       type(grid_t), intent(in) :: grid
       real(rp), intent(inout) :: field(:, :)
       real(rp), allocatable :: send_buf(:, :), recv_buf(:, :)
-      integer :: k, side, nv, plane_size, count, plane_index(2)
+      integer :: k, side, nv, plane_size, count, plane_index(2), layers, layer
       integer, parameter :: tag = 101
 
       nv = size(field, 1)
+      layers = 1 + 2 * grid%ghost
       do k = 1, domain%dim
          if (all(domain%neighbour(:, k) == MPI_PROC_NULL)) cycle
          plane_size = grid%node_count / grid%n_nodes(k)
          count = nv * plane_size
-         allocate (send_buf(count, 2), recv_buf(count, 2))
-         plane_index = [1, grid%n_nodes(k)]
+         allocate (send_buf(count * layers, 2), recv_buf(count * layers, 2))
+         ! the first plane of each side's group, the planes in ascending order on both ranks
+         plane_index = [1, grid%n_nodes(k) - layers + 1]
          do side = 1, 2
-            call pack_plane(grid, k, plane_index(side), field, send_buf(:, side))
+            do layer = 0, layers - 1
+               call pack_plane(grid, k, plane_index(side) + layer, field, &
+                               send_buf(layer * count + 1:(layer + 1) * count, side))
+            end do
          end do
          call exchange_with_face_neighbours(domain, k, send_buf, recv_buf, tag)
          do side = 1, 2
-            if (domain%neighbour(side, k) /= MPI_PROC_NULL) &
-               call add_plane(grid, k, plane_index(side), recv_buf(:, side), field)
+            if (domain%neighbour(side, k) == MPI_PROC_NULL) cycle
+            do layer = 0, layers - 1
+               call add_plane(grid, k, plane_index(side) + layer, recv_buf(layer * count + 1:(layer + 1) * count, side), &
+                              field)
+            end do
          end do
          deallocate (send_buf, recv_buf)
       end do

@@ -17,7 +17,8 @@ module mpm_solver
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use error_status, only: status_t
    use scene_description, only: scene_t, run_control_t, wall_spec_t, model_newtonian_fluid
-   use domain_decomposition, only: domain_t, layout_dims, fit_box
+   use domain_decomposition, only: domain_t, layout_dims, fit_box, min_slab_width
+   use shape_functions, only: shape_function_kind, ghost_node_layers
    use load_balance, only: balanced_layout
    use particle_redistribution, only: redistribute_particles
    use background_grid, only: grid_t, row_mass
@@ -127,6 +128,8 @@ contains
          need_hi = 0
       end if
       call target_box(need_lo, need_hi, guard_cells(1.0_rp) + slack_cells, grid_cells, dim, box_lo, box_hi)
+      self%grid%shape = shape_function_kind(scene%grid%shape_function)
+      self%domain%min_width = max(min_slab_width, 1 + 2 * ghost_node_layers(self%grid%shape))
       call self%domain%init(comm, dim, grid_cells, status, box_lo, box_hi)
       if (.not. status%ok) return
       self%grid%field_rows = contact_field_rows(scene)
@@ -338,7 +341,7 @@ contains
       call MPI_Allreduce(MPI_IN_PLACE, extent, 6, MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
       call needed_cells(self, extent(1:3), -extent(4:6), need_lo, need_hi)
       call target_box(need_lo, need_hi, guard_cells(1.0_rp) + slack_cells, self%grid%global_cells, dim, box_lo, box_hi)
-      call fit_box(self%domain%dims, self%grid%global_cells, box_lo, box_hi)
+      call fit_box(self%domain%dims, self%grid%global_cells, box_lo, box_hi, self%domain%min_width)
       call self%domain%box_cuts(box_lo, box_hi, cuts, kept)
       call self%set_layout(cuts, status, moved=.true.)
    end subroutine solver_cover_particles
@@ -701,7 +704,7 @@ contains
       guard = guard_cells(self%dt * speed * self%grid%inv_h)
       margin = guard + slack_cells
       call target_box(need_lo, need_hi, margin, self%grid%global_cells, dim, target_lo, target_hi)
-      call fit_box(self%domain%dims, self%grid%global_cells, target_lo, target_hi)
+      call fit_box(self%domain%dims, self%grid%global_cells, target_lo, target_hi, self%domain%min_width)
       call self%domain%region(box_lo, box_hi)
       if (.not. box_needs_change(box_lo, box_hi, need_lo, need_hi, guard, margin, target_lo, target_hi, &
                                  self%grid%global_cells, dim)) return

@@ -3,20 +3,22 @@
 !>   d~_i = sum_p N_ip m_p d_p / m_i ,   d_p := sum_i N_ip d~_i        (before the constitutive update)
 !>   s~_i = sum_p N_ip m_p s_p / m_i ,   s_p := sum_i N_ip s~_i        (after it)
 !> per material, with m_i = sum_p N_ip m_p of that material, at the positions x^n (the shape values
-!> are stored by `prepare`, before the particles move). Nodal sums use the solver's ghost-node sum.
+!> are stored by `prepare`, before the particles move). Nodal sums use the solver's ghost-node sum. N_ip are
+!> the grid's shape functions, multilinear or quadratic B-spline (the projection onto the nodes is the same
+!> lumped L2 projection whatever the stencil; docs/theory.md section 1.1).
 module node_based_anti_locking
    use kinds, only: rp
    use particle_set, only: particle_set_t
    use stabilizer, only: stabilizer_t, stage_context_t
-   use shape_functions, only: n_corners, shape_values_and_gradients
+   use shape_functions, only: stencil_base, stencil_values
    use background_grid, only: grid_t
    use node_halo, only: sum_shared_nodes
    implicit none
    private
 
    type, extends(stabilizer_t), public :: node_based_anti_locking_t
-      integer, allocatable :: base(:)            !< lower node of each particle's cell (slice order)
-      real(rp), allocatable :: weight(:, :)      !< N_a(x_p^n) of the cell's corners (slice order)
+      integer, allocatable :: base(:)            !< base node of each particle's stencil (slice order)
+      real(rp), allocatable :: weight(:, :)      !< N_a(x_p^n) of the stencil's nodes (slice order)
       real(rp), allocatable :: nodal_mass(:)     !< m_i of this material, summed over ranks
    contains
       procedure :: prepare => nb_prepare
@@ -31,26 +33,30 @@ contains
       class(node_based_anti_locking_t), intent(inout) :: self
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
-      real(rp) :: xi(3), gradients(3, 8)
-      integer :: p, q, a, c(3), first, last, dim
-      real(rp), allocatable :: mass(:, :)
+      real(rp) :: xi(3)
+      integer :: p, q, a, c(3), first, last, dim, k
+      real(rp), allocatable :: mass(:, :), gradients(:, :)
 
       associate (grid => context%grid)
          dim = grid%dim
          first = context%first
          last = context%last
          if (allocated(self%base)) deallocate (self%base, self%weight)
-         allocate (self%base(max(0, last - first + 1)), self%weight(n_corners(dim), max(0, last - first + 1)))
-         allocate (mass(1, grid%node_count))
+         allocate (self%base(max(0, last - first + 1)), self%weight(grid%stencil_size, max(0, last - first + 1)))
+         allocate (mass(1, grid%node_count), gradients(dim, grid%stencil_size))
          mass = 0.0_rp
          do p = first, last
             q = p - first + 1
-            c = grid%cell_of_position(particles%x(:, p))
+            xi(1:dim) = (particles%x(:, p) - grid%origin(1:dim)) * grid%inv_h
+            c = 0
+            do k = 1, dim
+               c(k) = stencil_base(grid%shape, xi(k), grid%global_cells(k))
+            end do
             self%base(q) = grid%local_node(c)
-            xi(1:dim) = (particles%x(:, p) - grid%origin(1:dim)) * grid%inv_h - c(1:dim)
-            call shape_values_and_gradients(dim, xi(1:dim), grid%inv_h, self%weight(:, q), gradients(1:dim, 1:2**dim))
-            do a = 1, n_corners(dim)
-               associate (node => self%base(q) + grid%corner_stride(a))
+            xi(1:dim) = xi(1:dim) - c(1:dim)
+            call stencil_values(grid%shape, dim, xi(1:dim), grid%inv_h, self%weight(:, q), gradients)
+            do a = 1, grid%stencil_size
+               associate (node => self%base(q) + grid%stencil_stride(a))
                   mass(1, node) = mass(1, node) + self%weight(a, q) * particles%mass(p)
                end associate
             end do
@@ -89,8 +95,8 @@ contains
       allocate (nodal(size(values, 1), grid%node_count))
       nodal = 0.0_rp
       do q = 1, size(values, 2)
-         do a = 1, n_corners(grid%dim)
-            node = self%base(q) + grid%corner_stride(a)
+         do a = 1, grid%stencil_size
+            node = self%base(q) + grid%stencil_stride(a)
             nodal(:, node) = nodal(:, node) + self%weight(a, q) * particles%mass(context%first + q - 1) * values(:, q)
          end do
       end do
@@ -100,8 +106,8 @@ contains
       end do
       do q = 1, size(values, 2)
          values(:, q) = 0.0_rp
-         do a = 1, n_corners(grid%dim)
-            node = self%base(q) + grid%corner_stride(a)
+         do a = 1, grid%stencil_size
+            node = self%base(q) + grid%stencil_stride(a)
             values(:, q) = values(:, q) + self%weight(a, q) * nodal(:, node)
          end do
       end do

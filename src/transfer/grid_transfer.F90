@@ -1,18 +1,30 @@
 !> Particle-grid transfers of the explicit MPM step (algorithms.md section 1.2, steps 1, 3 and 7).
 !>
-!> The kernels are written once, in grid_transfer_kernels.inc, and instantiated for 2-D and 3-D with the
-!> dimension as a compile-time constant, so that the loops over axes and corners unroll. The public
-!> routines pick the instance from grid%dim.
+!> The kernels are written once, in grid_transfer_kernels.inc, and instantiated for 2-D and 3-D and for
+!> each shape function (multilinear, quadratic B-spline) with the dimension and the stencil as
+!> compile-time constants, so that the loops over axes and stencil nodes unroll. The public routines pick
+!> the instance from grid%dim and grid%shape (the scene's &grid shape_function).
 module grid_transfer
    use kinds, only: rp
    use background_grid, only: grid_t, row_mass
+   use shape_functions, only: shape_bspline2
    use particle_set, only: particle_set_t
    implicit none
    private
 
    public :: particles_to_grid, update_velocity_and_remap, grid_to_particles, volume_to_grid, gradient_at_particles
 
+   !> The kernel instances: dimension and shape function.
+   integer, parameter :: kernels_linear_2d = 1, kernels_linear_3d = 2, kernels_bspline2_2d = 3, kernels_bspline2_3d = 4
+
 contains
+
+   !> The kernel instance of a grid.
+   pure integer function instance(grid)
+      type(grid_t), intent(in) :: grid
+      instance = merge(kernels_linear_2d, kernels_linear_3d, grid%dim == 2)
+      if (grid%shape == shape_bspline2) instance = instance + 2
+   end function instance
 
    !> Step 1: m_i = sum N m_p, P_i = sum N m_p v_p,
    !> f_i = -sum m_p sbar_p . grad N_i + sum N m_p g   ([Y17] eq. 3; sbar is the filtered stress).
@@ -26,15 +38,19 @@ contains
       integer, intent(in), optional :: field(:), field_row
       grid%accumulated = 0.0_rp
       if (present(field)) then
-         if (grid%dim == 2) then
-            call particles_to_grid_fields_2d(grid, particles, gravity, field, field_row)
-         else
-            call particles_to_grid_fields_3d(grid, particles, gravity, field, field_row)
-         end if
-      else if (grid%dim == 2) then
-         call particles_to_grid_2d(grid, particles, gravity)
+         select case (instance(grid))
+         case (kernels_linear_2d); call particles_to_grid_fields_2d(grid, particles, gravity, field, field_row)
+         case (kernels_linear_3d); call particles_to_grid_fields_3d(grid, particles, gravity, field, field_row)
+         case (kernels_bspline2_2d); call particles_to_grid_fields_b2_2d(grid, particles, gravity, field, field_row)
+         case default; call particles_to_grid_fields_b2_3d(grid, particles, gravity, field, field_row)
+         end select
       else
-         call particles_to_grid_3d(grid, particles, gravity)
+         select case (instance(grid))
+         case (kernels_linear_2d); call particles_to_grid_2d(grid, particles, gravity)
+         case (kernels_linear_3d); call particles_to_grid_3d(grid, particles, gravity)
+         case (kernels_bspline2_2d); call particles_to_grid_b2_2d(grid, particles, gravity)
+         case default; call particles_to_grid_b2_3d(grid, particles, gravity)
+         end select
       end if
    end subroutine particles_to_grid
 
@@ -51,15 +67,23 @@ contains
       real(rp), intent(in), optional :: velocity(:, :), increment(:, :)
       momentum = 0.0_rp
       if (present(field)) then
-         if (grid%dim == 2) then
+         select case (instance(grid))
+         case (kernels_linear_2d)
             call momentum_to_grid_fields_2d(grid, particles, flip_fraction, momentum, field, velocity, increment)
-         else
+         case (kernels_linear_3d)
             call momentum_to_grid_fields_3d(grid, particles, flip_fraction, momentum, field, velocity, increment)
-         end if
-      else if (grid%dim == 2) then
-         call momentum_to_grid_2d(grid, particles, flip_fraction, momentum)
+         case (kernels_bspline2_2d)
+            call momentum_to_grid_fields_b2_2d(grid, particles, flip_fraction, momentum, field, velocity, increment)
+         case default
+            call momentum_to_grid_fields_b2_3d(grid, particles, flip_fraction, momentum, field, velocity, increment)
+         end select
       else
-         call momentum_to_grid_3d(grid, particles, flip_fraction, momentum)
+         select case (instance(grid))
+         case (kernels_linear_2d); call momentum_to_grid_2d(grid, particles, flip_fraction, momentum)
+         case (kernels_linear_3d); call momentum_to_grid_3d(grid, particles, flip_fraction, momentum)
+         case (kernels_bspline2_2d); call momentum_to_grid_b2_2d(grid, particles, flip_fraction, momentum)
+         case default; call momentum_to_grid_b2_3d(grid, particles, flip_fraction, momentum)
+         end select
       end if
    end subroutine update_velocity_and_remap
 
@@ -91,20 +115,38 @@ contains
       lo = 0.0_rp
       hi = 0.0_rp
       if (present(field)) then
-         if (grid%dim == 2) then
+         select case (instance(grid))
+         case (kernels_linear_2d)
             call grid_to_particles_fields_2d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
                                              spin, update_position, lo(1:2), hi(1:2), field, velocity, increment, &
                                              strain_velocity)
-         else
+         case (kernels_linear_3d)
             call grid_to_particles_fields_3d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
                                              spin, update_position, lo, hi, field, velocity, increment, strain_velocity)
-         end if
-      else if (grid%dim == 2) then
-         call grid_to_particles_2d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
-                                   spin, update_position, lo(1:2), hi(1:2), strain_velocity)
+         case (kernels_bspline2_2d)
+            call grid_to_particles_fields_b2_2d(grid, particles, dt, flip_fraction, theta, update_velocity, &
+                                                compute_strain, spin, update_position, lo(1:2), hi(1:2), field, &
+                                                velocity, increment, strain_velocity)
+         case default
+            call grid_to_particles_fields_b2_3d(grid, particles, dt, flip_fraction, theta, update_velocity, &
+                                                compute_strain, spin, update_position, lo, hi, field, velocity, &
+                                                increment, strain_velocity)
+         end select
       else
-         call grid_to_particles_3d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
-                                   spin, update_position, lo, hi, strain_velocity)
+         select case (instance(grid))
+         case (kernels_linear_2d)
+            call grid_to_particles_2d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
+                                      spin, update_position, lo(1:2), hi(1:2), strain_velocity)
+         case (kernels_linear_3d)
+            call grid_to_particles_3d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
+                                      spin, update_position, lo, hi, strain_velocity)
+         case (kernels_bspline2_2d)
+            call grid_to_particles_b2_2d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
+                                         spin, update_position, lo(1:2), hi(1:2), strain_velocity)
+         case default
+            call grid_to_particles_b2_3d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
+                                         spin, update_position, lo, hi, strain_velocity)
+         end select
       end if
       if (present(extent)) then
          extent(:, 1) = lo
@@ -117,15 +159,16 @@ contains
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(in) :: particles
       real(rp), intent(inout) :: occupancy(:)
-      if (grid%dim == 2) then
-         call volume_to_grid_2d(grid, particles, occupancy)
-      else
-         call volume_to_grid_3d(grid, particles, occupancy)
-      end if
+      select case (instance(grid))
+      case (kernels_linear_2d); call volume_to_grid_2d(grid, particles, occupancy)
+      case (kernels_linear_3d); call volume_to_grid_3d(grid, particles, occupancy)
+      case (kernels_bspline2_2d); call volume_to_grid_b2_2d(grid, particles, occupancy)
+      case default; call volume_to_grid_b2_3d(grid, particles, occupancy)
+      end select
    end subroutine volume_to_grid
 
    !> gradient(:, p) = sum_a grad N_a(x_p) field_a for p = first..last at x^n; a node that is not `known`
-   !> takes the N-weighted mean of the particle's known corners.
+   !> takes the N-weighted mean of the particle's known stencil nodes.
    subroutine gradient_at_particles(grid, particles, first, last, field, known, gradient)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(in) :: particles
@@ -133,11 +176,12 @@ contains
       real(rp), intent(in) :: field(:)
       logical, intent(in) :: known(:)
       real(rp), intent(inout) :: gradient(:, :)
-      if (grid%dim == 2) then
-         call gradient_at_particles_2d(grid, particles, first, last, field, known, gradient)
-      else
-         call gradient_at_particles_3d(grid, particles, first, last, field, known, gradient)
-      end if
+      select case (instance(grid))
+      case (kernels_linear_2d); call gradient_at_particles_2d(grid, particles, first, last, field, known, gradient)
+      case (kernels_linear_3d); call gradient_at_particles_3d(grid, particles, first, last, field, known, gradient)
+      case (kernels_bspline2_2d); call gradient_at_particles_b2_2d(grid, particles, first, last, field, known, gradient)
+      case default; call gradient_at_particles_b2_3d(grid, particles, first, last, field, known, gradient)
+      end select
    end subroutine gradient_at_particles
 
 ! Single-field kernels: nodal velocities from the grid
@@ -145,7 +189,9 @@ contains
 #define INC(i, node) grid%velocity_increment(i, node)
 
 #define KERNEL_DIM 2
+#define WIDTH 2
 #define SHAPE shape_2d
+#define BASE base_linear
 #define LOCATE locate_2d
 #define P2G particles_to_grid_2d
 #define M2G momentum_to_grid_2d
@@ -155,7 +201,9 @@ contains
 #include "../grid/multilinear_shape.inc"
 #include "grid_transfer_kernels.inc"
 #undef KERNEL_DIM
+#undef WIDTH
 #undef SHAPE
+#undef BASE
 #undef LOCATE
 #undef P2G
 #undef M2G
@@ -164,7 +212,9 @@ contains
 #undef GRAD2P
 
 #define KERNEL_DIM 3
+#define WIDTH 2
 #define SHAPE shape_3d
+#define BASE base_linear
 #define LOCATE locate_3d
 #define P2G particles_to_grid_3d
 #define M2G momentum_to_grid_3d
@@ -174,7 +224,55 @@ contains
 #include "../grid/multilinear_shape.inc"
 #include "grid_transfer_kernels.inc"
 #undef KERNEL_DIM
+#undef WIDTH
 #undef SHAPE
+#undef BASE
+#undef LOCATE
+#undef P2G
+#undef M2G
+#undef G2P
+#undef V2G
+#undef GRAD2P
+
+#define KERNEL_DIM 2
+#define WIDTH 3
+#define SHAPE bspline2_2d
+#define BASE base_bspline2
+#define LOCATE locate_b2_2d
+#define P2G particles_to_grid_b2_2d
+#define M2G momentum_to_grid_b2_2d
+#define G2P grid_to_particles_b2_2d
+#define V2G volume_to_grid_b2_2d
+#define GRAD2P gradient_at_particles_b2_2d
+#include "../grid/bspline2_shape.inc"
+#include "grid_transfer_kernels.inc"
+#undef KERNEL_DIM
+#undef WIDTH
+#undef SHAPE
+#undef BASE
+#undef LOCATE
+#undef P2G
+#undef M2G
+#undef G2P
+#undef V2G
+#undef GRAD2P
+
+#define KERNEL_DIM 3
+#define WIDTH 3
+#define SHAPE bspline2_3d
+#define BASE base_bspline2
+#define LOCATE locate_b2_3d
+#define P2G particles_to_grid_b2_3d
+#define M2G momentum_to_grid_b2_3d
+#define G2P grid_to_particles_b2_3d
+#define V2G volume_to_grid_b2_3d
+#define GRAD2P gradient_at_particles_b2_3d
+#include "../grid/bspline2_shape.inc"
+#include "grid_transfer_kernels.inc"
+#undef KERNEL_DIM
+#undef WIDTH
+#undef SHAPE
+#undef BASE
 #undef LOCATE
 #undef P2G
 #undef M2G
@@ -190,24 +288,74 @@ contains
 #define INC(i, node) increment(o + (i), node)
 
 #define KERNEL_DIM 2
+#define WIDTH 2
 #define SHAPE shape_2d
+#define BASE base_linear
 #define LOCATE locate_2d
 #define P2G particles_to_grid_fields_2d
 #define M2G momentum_to_grid_fields_2d
 #define G2P grid_to_particles_fields_2d
 #include "grid_transfer_kernels.inc"
 #undef KERNEL_DIM
+#undef WIDTH
 #undef SHAPE
+#undef BASE
 #undef LOCATE
 #undef P2G
 #undef M2G
 #undef G2P
 
 #define KERNEL_DIM 3
+#define WIDTH 2
 #define SHAPE shape_3d
+#define BASE base_linear
 #define LOCATE locate_3d
 #define P2G particles_to_grid_fields_3d
 #define M2G momentum_to_grid_fields_3d
 #define G2P grid_to_particles_fields_3d
 #include "grid_transfer_kernels.inc"
+#undef KERNEL_DIM
+#undef WIDTH
+#undef SHAPE
+#undef BASE
+#undef LOCATE
+#undef P2G
+#undef M2G
+#undef G2P
+
+#define KERNEL_DIM 2
+#define WIDTH 3
+#define SHAPE bspline2_2d
+#define BASE base_bspline2
+#define LOCATE locate_b2_2d
+#define P2G particles_to_grid_fields_b2_2d
+#define M2G momentum_to_grid_fields_b2_2d
+#define G2P grid_to_particles_fields_b2_2d
+#include "grid_transfer_kernels.inc"
+#undef KERNEL_DIM
+#undef WIDTH
+#undef SHAPE
+#undef BASE
+#undef LOCATE
+#undef P2G
+#undef M2G
+#undef G2P
+
+#define KERNEL_DIM 3
+#define WIDTH 3
+#define SHAPE bspline2_3d
+#define BASE base_bspline2
+#define LOCATE locate_b2_3d
+#define P2G particles_to_grid_fields_b2_3d
+#define M2G momentum_to_grid_fields_b2_3d
+#define G2P grid_to_particles_fields_b2_3d
+#include "grid_transfer_kernels.inc"
+#undef KERNEL_DIM
+#undef WIDTH
+#undef SHAPE
+#undef BASE
+#undef LOCATE
+#undef P2G
+#undef M2G
+#undef G2P
 end module grid_transfer

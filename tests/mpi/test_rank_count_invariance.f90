@@ -18,7 +18,7 @@ module test_rank_count_invariance
 
    public :: test_hydrostatic_tank_rank_invariance, test_settling_tank_rank_invariance, test_schemes_rank_invariance, &
              test_collapsing_column_rank_invariance, test_collapsing_column_3d_rank_invariance, &
-             test_collapsing_column_cfl_rank_invariance
+             test_collapsing_column_cfl_rank_invariance, test_bspline2_rank_invariance
 
    integer, parameter :: n_steps = 200
 
@@ -87,14 +87,39 @@ contains
       call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [1.0_rp, 1.0_rp, 0.0_rp], 2, .false., 0.0_rp)
    end function collapsing_column
 
+   !> A 0.6 m cube of water in the corner of a 2 m x 0.6 m x 1.2 m box, h = 0.1 m, 2 x 2 x 2 per cell.
+   type(scene_t) function collapsing_column_3d() result(scene)
+      scene = water_scene(3, 0.1_rp, [2.0_rp, 0.6_rp, 1.2_rp], 2.0e6_rp, 9.81_rp)
+      call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [0.6_rp, 0.6_rp, 0.6_rp], 2, .false., 0.0_rp)
+   end function collapsing_column_3d
+
    subroutine test_collapsing_column_3d_rank_invariance(comm)
       type(MPI_Comm), intent(in) :: comm
       type(scene_t) :: scene
-      scene = water_scene(3, 0.1_rp, [2.0_rp, 0.6_rp, 1.2_rp], 2.0e6_rp, 9.81_rp)
-      call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [0.6_rp, 0.6_rp, 0.6_rp], 2, .false., 0.0_rp)
+      scene = collapsing_column_3d()
       scene%run%fixed_dt = 1.0e-3_rp
       call compare_rank_counts(comm, scene)
    end subroutine test_collapsing_column_3d_rank_invariance
+
+   !> Quadratic B-splines (3-plane node halo, ghost layers, slabs of 3 cells): the collapsing column in 2-D
+   !> plain and with each scheme that combines with them (C0, NB, FOAL1), and in 3-D.
+   subroutine test_bspline2_rank_invariance(comm)
+      type(MPI_Comm), intent(in) :: comm
+      character(len=5), parameter :: schemes(4) = [character(len=5) :: 'none', 'C0', 'NB', 'FOAL1']
+      type(scene_t) :: scene
+      integer :: i
+      do i = 1, size(schemes)
+         scene = collapsing_column()
+         scene%grid%shape_function = 'bspline2'
+         scene%run%fixed_dt = 5.0e-4_rp
+         scene%materials(1)%stabilization = schemes(i)
+         call compare_rank_counts(comm, scene, label='bspline2 collapsing column, '//trim(schemes(i)))
+      end do
+      scene = collapsing_column_3d()
+      scene%grid%shape_function = 'bspline2'
+      scene%run%fixed_dt = 1.0e-3_rp
+      call compare_rank_counts(comm, scene, label='bspline2 3-D collapsing column')
+   end subroutine test_bspline2_rank_invariance
 
    !> Run on a one-rank communicator (rank 0 alone) and on `comm`; compare. Optional scales replace
    !> the serial value as the reference of the relative tolerance when they are larger.

@@ -331,7 +331,7 @@ contains
          l = 0.0_rp
          do a = 1, n_corners(2)
             do k = 1, 2
-               l(:, k) = l(:, k) + solver%grid%velocity(:, base + solver%grid%corner_stride(a)) * g(k, a)
+               l(:, k) = l(:, k) + solver%grid%velocity(:, base + solver%grid%stencil_stride(a)) * g(k, a)
             end do
          end do
          d_expected = [l(1, 1), l(2, 2), 0.0_rp, 0.5_rp * (l(1, 2) + l(2, 1))]
