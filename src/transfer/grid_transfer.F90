@@ -3,18 +3,23 @@
 !> The kernels are written once, in grid_transfer_kernels.inc, and instantiated for 2-D and 3-D with the
 !> dimension as a compile-time constant, so that the loops over axes and corners unroll. The public
 !> routines pick the instance from grid%dim.
+!>
+!> The velocity transfer is FLIP/PIC, or APIC when the particles carry the affine matrix B_p
+!> (particles%n_affine > 0, `&run transfer = 'apic'`; docs/theory.md, "APIC").
 module grid_transfer
    use kinds, only: rp
    use background_grid, only: grid_t, row_mass
    use particle_set, only: particle_set_t
+   use shape_functions, only: corner_offset
    implicit none
    private
 
-   public :: particles_to_grid, update_velocity_and_remap, grid_to_particles, volume_to_grid, gradient_at_particles
+   public :: particles_to_grid, update_velocity_and_remap, grid_to_particles, volume_to_grid, gradient_at_particles, &
+             node_offsets
 
 contains
 
-   !> Step 1: m_i = sum N m_p, P_i = sum N m_p v_p,
+   !> Step 1: m_i = sum N m_p, P_i = sum N m_p v_p (APIC: + sum m_p B_p D_p^-1 (x_i - x_p) N),
    !> f_i = -sum m_p sbar_p . grad N_i + sum N m_p g   ([Y17] eq. 3; sbar is the filtered stress).
    !> With `field` (contact, src/solver/body_contact.f90): also each body field's mass, momentum, force and
    !> mass gradient sum m_p grad N_i in its rows of grid%accumulated from `field_row` on (field(p) = 0: the
@@ -40,6 +45,7 @@ contains
 
    !> MUSL, first half of step 7 fused with the re-map: v_p := alpha (v_p + sum N dv_i) + (1 - alpha) sum N
    !> v_i^{n+1}, then momentum(:, i) = sum N m_p v_p with the updated velocities (both at x^n).
+   !> APIC: v_p := sum N v_i^{n+1}, B_p := sum N v_i^{n+1} (x_i - x_p)^T, and the momentum as in step 1.
    !> With `field`: each particle's nodal velocities come from its field's rows of `velocity` and
    !> `increment` (dim (fields + 1), node); momentum rows 1:dim get the total, rows f dim + 1.. field f's.
    subroutine update_velocity_and_remap(grid, particles, flip_fraction, momentum, field, velocity, increment)
@@ -66,6 +72,7 @@ contains
    !> Steps 3 and 7 at x^n. With v_i^{n+theta} = v_i^{n+1} - (1 - theta) dv_i:
    !>   L_p = sum v_i^{n+theta} (x) grad N_i  -> strain_rate = sym(L), spin = skew(L)   (if compute_strain)
    !>   v_p := alpha (v_p + sum N dv_i) + (1 - alpha) sum N v_i^{n+1}                  (if update_velocity)
+   !>          APIC: v_p := sum N v_i^{n+1}, B_p := sum N v_i^{n+1} (x_i - x_p)^T
    !>   x_p := x_p + dt sum N v_i^{n+theta}                                             (if update_position)
    !> `strain_velocity`, when present, replaces v^{n+theta} in L (MUSL: the re-mapped velocities).
    !> `compute_spin` (default: as compute_strain) = .false. leaves the spin alone: only solids use it.
@@ -112,6 +119,19 @@ contains
       end if
    end subroutine grid_to_particles
 
+   !> d(:, a) = x_a - x_p for the stencil nodes a of a particle at fractional position xi in a cell of
+   !> edge h (APIC's offsets; exposed for the tests of D_p).
+   pure subroutine node_offsets(dim, xi, h, d)
+      integer, intent(in) :: dim
+      real(rp), intent(in) :: xi(:), h
+      real(rp), intent(out) :: d(:, :)
+      if (dim == 2) then
+         call node_offsets_2d(xi, h, d)
+      else
+         call node_offsets_3d(xi, h, d)
+      end if
+   end subroutine node_offsets
+
    !> o_i += sum_p N_ip m_p / rho_p over all particles (src/stabilization/volume_correction.f90).
    subroutine volume_to_grid(grid, particles, occupancy)
       type(grid_t), intent(in) :: grid
@@ -140,6 +160,11 @@ contains
       end if
    end subroutine gradient_at_particles
 
+! APIC's D_p^-1 (x_a - x_p) N_a of node a: for multilinear shape functions it is grad N_a exactly, also on
+! the grid lines where D_p is singular (docs/theory.md, "APIC"). For B-splines it is not grad N_a: a
+! B-spline stencil puts d(j, a) n(a) / D here (D = h^2/4 quadratic, h^2/3 cubic; d from OFFSETS).
+#define AFFINE_WEIGHT(j, a) g(j, a)
+
 ! Single-field kernels: nodal velocities from the grid
 #define VEL(i, node) grid%velocity(i, node)
 #define INC(i, node) grid%velocity_increment(i, node)
@@ -147,6 +172,7 @@ contains
 #define KERNEL_DIM 2
 #define SHAPE shape_2d
 #define LOCATE locate_2d
+#define OFFSETS node_offsets_2d
 #define P2G particles_to_grid_2d
 #define M2G momentum_to_grid_2d
 #define G2P grid_to_particles_2d
@@ -157,6 +183,7 @@ contains
 #undef KERNEL_DIM
 #undef SHAPE
 #undef LOCATE
+#undef OFFSETS
 #undef P2G
 #undef M2G
 #undef G2P
@@ -166,6 +193,7 @@ contains
 #define KERNEL_DIM 3
 #define SHAPE shape_3d
 #define LOCATE locate_3d
+#define OFFSETS node_offsets_3d
 #define P2G particles_to_grid_3d
 #define M2G momentum_to_grid_3d
 #define G2P grid_to_particles_3d
@@ -176,6 +204,7 @@ contains
 #undef KERNEL_DIM
 #undef SHAPE
 #undef LOCATE
+#undef OFFSETS
 #undef P2G
 #undef M2G
 #undef G2P
@@ -192,6 +221,7 @@ contains
 #define KERNEL_DIM 2
 #define SHAPE shape_2d
 #define LOCATE locate_2d
+#define OFFSETS node_offsets_2d
 #define P2G particles_to_grid_fields_2d
 #define M2G momentum_to_grid_fields_2d
 #define G2P grid_to_particles_fields_2d
@@ -199,6 +229,7 @@ contains
 #undef KERNEL_DIM
 #undef SHAPE
 #undef LOCATE
+#undef OFFSETS
 #undef P2G
 #undef M2G
 #undef G2P
@@ -206,6 +237,7 @@ contains
 #define KERNEL_DIM 3
 #define SHAPE shape_3d
 #define LOCATE locate_3d
+#define OFFSETS node_offsets_3d
 #define P2G particles_to_grid_fields_3d
 #define M2G momentum_to_grid_fields_3d
 #define G2P grid_to_particles_fields_3d
