@@ -17,7 +17,8 @@ module test_rank_count_invariance
    private
 
    public :: test_hydrostatic_tank_rank_invariance, test_settling_tank_rank_invariance, test_schemes_rank_invariance, &
-             test_collapsing_column_rank_invariance, test_collapsing_column_3d_rank_invariance
+             test_collapsing_column_rank_invariance, test_collapsing_column_3d_rank_invariance, &
+             test_apic_column_rank_invariance
 
    integer, parameter :: n_steps = 200
 
@@ -80,6 +81,22 @@ contains
       scene%run%fixed_dt = 1.0e-3_rp
       call compare_rank_counts(comm, scene)
    end subroutine test_collapsing_column_3d_rank_invariance
+
+   !> The collapsing columns (2-D, 3-D) with APIC: the affine matrices migrate with their particles.
+   subroutine test_apic_column_rank_invariance(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(scene_t) :: scene
+      scene = water_scene(2, 0.05_rp, [4.0_rp, 2.0_rp, 0.0_rp], 2.0e6_rp, 9.81_rp)
+      call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [1.0_rp, 1.0_rp, 0.0_rp], 2, .false., 0.0_rp)
+      scene%run%fixed_dt = 5.0e-4_rp
+      scene%run%transfer = 'apic'
+      call compare_rank_counts(comm, scene, label='2-D, APIC')
+      scene = water_scene(3, 0.1_rp, [2.0_rp, 0.6_rp, 1.2_rp], 2.0e6_rp, 9.81_rp)
+      call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [0.6_rp, 0.6_rp, 0.6_rp], 2, .false., 0.0_rp)
+      scene%run%fixed_dt = 1.0e-3_rp
+      scene%run%transfer = 'apic'
+      call compare_rank_counts(comm, scene, label='3-D, APIC')
+   end subroutine test_apic_column_rank_invariance
 
    !> Run on a one-rank communicator (rank 0 alone) and on `comm`; compare. Optional scales replace
    !> the serial value as the reference of the relative tolerance when they are larger.
