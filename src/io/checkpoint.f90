@@ -2,7 +2,8 @@
 !> (docs/output.md, "Checkpoints and restart").
 !>
 !> Saved: every particle's persistent state (position, velocity, mass, density, sbar, material, id, and
-!> with APIC the affine matrix B_p as /particles/affine) in each rank's order, the rank each slab came from, time, step, the next dt, the per-rank counters
+!> with APIC the affine matrix C_p as /particles/affine) in each rank's order, the rank each slab came
+!> from, time, step, the next dt, the per-rank counters
 !> (lost particles, wall corrections), the empty-node mass tolerance, and the run's progress (next
 !> output time, the outputs written so far, the checkpoint number) and the decomposition (rank count
 !> and slab boundaries, which load balancing may have moved). Restarting on the same number of ranks
@@ -63,7 +64,7 @@ module checkpoint
       integer, allocatable :: cuts(:)
       integer :: n = 0                            !< particles this rank read
       real(rp), allocatable :: x(:, :), v(:, :), mass(:), density(:), sbar(:, :)
-      real(rp), allocatable :: affine(:, :)       !< APIC's B_p (dim**2, p); zero size without APIC
+      real(rp), allocatable :: affine(:, :)       !< APIC's C_p (dim**2, p); zero size without APIC
       integer, allocatable :: material(:)
       integer(i8), allocatable :: id(:)
    end type saved_state_t
@@ -391,7 +392,7 @@ contains
       call file%read_slab('particles/sbar', slab, state%sbar, status)
       call file%read_slab('particles/material', slab, state%material, status)
       call file%read_slab('particles/id', slab, state%id, status)
-      ! APIC's B_p; zero (the velocity uniform around each particle) if the run before had no APIC, which
+      ! APIC's C_p; zero (the velocity uniform around each particle) if the run before had no APIC, which
       ! only --allow-scene-change lets a restart change
       allocate (state%affine(merge(scene%grid%dim**2, 0, scene%run%transfer == 'apic'), m))
       state%affine = 0.0_rp

@@ -2,7 +2,7 @@
 !>
 !> Persistent state: position, velocity, mass, density, mass-specific stress sbar = sigma / rho
 !> (algorithms.md section 1), material, global id, and with APIC (`&run transfer = 'apic'`) the affine
-!> matrix B_p (docs/theory.md, "APIC"; not allocated otherwise: n_affine = 0). Scratch per step: the (filtered) rate of deformation
+!> matrix C_p (docs/theory.md, "APIC"; not allocated otherwise: n_affine = 0). Scratch per step: the (filtered) rate of deformation
 !> and the spin. After `sort_by_material_and_cell` the particles of material m occupy the contiguous
 !> range material_first(m):material_last(m), ordered by cell, so material updates and cell sums run
 !> over contiguous slices.
@@ -28,7 +28,7 @@ module particle_set
       real(rp), allocatable :: mass(:)              !< mass [kg] (per unit thickness in 2-D)
       real(rp), allocatable :: density(:)           !< current density [kg/m^3]
       real(rp), allocatable :: sbar(:, :)           !< mass-specific stress (n_sigma, p) [Pa m^3/kg]
-      !> APIC's B_p = sum_i N_ip v_i (x_i - x_p)^T, column-major (n_affine, p) [m^2/s]; C_p = B_p D_p^-1
+      !> APIC's C_p = sum_i v_i (x) grad N_ip = B_p D_p^-1, column-major (n_affine, p) [1/s]
       real(rp), allocatable :: affine(:, :)
       integer, allocatable :: material(:)           !< material index
       integer(i8), allocatable :: id(:)             !< globally unique id
@@ -257,7 +257,7 @@ contains
    end subroutine particles_append_record
 
    !> Append one particle given its persistent state (dropped if the arrays cannot grow: see allocation).
-   !> `affine`: its B_p with APIC (default zero: a uniform velocity, as seeding and inflow create).
+   !> `affine`: its C_p with APIC (default zero: a uniform velocity, as seeding and inflow create).
    subroutine particles_add(self, x, v, mass, density, sbar, material, id, affine)
       class(particle_set_t), intent(inout) :: self
       real(rp), intent(in) :: x(:), v(:), mass, density, sbar(:)

@@ -4,7 +4,7 @@
 !> dimension as a compile-time constant, so that the loops over axes and corners unroll. The public
 !> routines pick the instance from grid%dim.
 !>
-!> The velocity transfer is FLIP/PIC, or APIC when the particles carry the affine matrix B_p
+!> The velocity transfer is FLIP/PIC, or APIC when the particles carry the affine matrix C_p
 !> (particles%n_affine > 0, `&run transfer = 'apic'`; docs/theory.md, "APIC").
 module grid_transfer
    use kinds, only: rp
@@ -19,7 +19,7 @@ module grid_transfer
 
 contains
 
-   !> Step 1: m_i = sum N m_p, P_i = sum N m_p v_p (APIC: + sum m_p B_p D_p^-1 (x_i - x_p) N),
+   !> Step 1: m_i = sum N m_p, P_i = sum N m_p v_p (APIC: + sum N m_p C_p (x_i - x_p)),
    !> f_i = -sum m_p sbar_p . grad N_i + sum N m_p g   ([Y17] eq. 3; sbar is the filtered stress).
    !> With `field` (contact, src/solver/body_contact.f90): also each body field's mass, momentum, force and
    !> mass gradient sum m_p grad N_i in its rows of grid%accumulated from `field_row` on (field(p) = 0: the
@@ -45,7 +45,7 @@ contains
 
    !> MUSL, first half of step 7 fused with the re-map: v_p := alpha (v_p + sum N dv_i) + (1 - alpha) sum N
    !> v_i^{n+1}, then momentum(:, i) = sum N m_p v_p with the updated velocities (both at x^n).
-   !> APIC: v_p := sum N v_i^{n+1}, B_p := sum N v_i^{n+1} (x_i - x_p)^T, and the momentum as in step 1.
+   !> APIC: v_p := sum N v_i^{n+1}, C_p := sum v_i^{n+1} (x) grad N, and the momentum as in step 1.
    !> With `field`: each particle's nodal velocities come from its field's rows of `velocity` and
    !> `increment` (dim (fields + 1), node); momentum rows 1:dim get the total, rows f dim + 1.. field f's.
    subroutine update_velocity_and_remap(grid, particles, flip_fraction, momentum, field, velocity, increment)
@@ -72,7 +72,7 @@ contains
    !> Steps 3 and 7 at x^n. With v_i^{n+theta} = v_i^{n+1} - (1 - theta) dv_i:
    !>   L_p = sum v_i^{n+theta} (x) grad N_i  -> strain_rate = sym(L), spin = skew(L)   (if compute_strain)
    !>   v_p := alpha (v_p + sum N dv_i) + (1 - alpha) sum N v_i^{n+1}                  (if update_velocity)
-   !>          APIC: v_p := sum N v_i^{n+1}, B_p := sum N v_i^{n+1} (x_i - x_p)^T
+   !>          APIC: v_p := sum N v_i^{n+1}, C_p := sum v_i^{n+1} (x) grad N
    !>   x_p := x_p + dt sum N v_i^{n+theta}                                             (if update_position)
    !> `strain_velocity`, when present, replaces v^{n+theta} in L (MUSL: the re-mapped velocities).
    !> `compute_spin` (default: as compute_strain) = .false. leaves the spin alone: only solids use it.
@@ -160,10 +160,11 @@ contains
       end if
    end subroutine gradient_at_particles
 
-! APIC's D_p^-1 (x_a - x_p) N_a of node a: for multilinear shape functions it is grad N_a exactly, also on
-! the grid lines where D_p is singular (docs/theory.md, "APIC"). For B-splines it is not grad N_a: a
-! B-spline stencil puts d(j, a) n(a) / D here (D = h^2/4 quadratic, h^2/3 cubic; d from OFFSETS).
-#define AFFINE_WEIGHT(j, a) g(j, a)
+! APIC's C_p = B_p D_p^-1 = sum_a v_a (x) D_p^-1 (x_a - x_p) N_a: for multilinear shape functions
+! D_p^-1 (x_a - x_p) N_a is grad N_a exactly, also on the grid lines where D_p is singular (docs/theory.md,
+! "APIC"). For B-splines it is not grad N_a: a B-spline stencil puts d(j, a) n(a) / D here (D = h^2/4
+! quadratic, h^2/3 cubic; d(:, a) = x_a - x_p from OFFSETS, which G2P and M2G then need too).
+#define AFFINE_GRADIENT(j, a) g(j, a)
 
 ! Single-field kernels: nodal velocities from the grid
 #define VEL(i, node) grid%velocity(i, node)

@@ -40,12 +40,13 @@ contains
       end do
    end subroutine test_collapsing_column_rebalanced
 
-   !> The collapsing column with APIC: the affine matrices go with their particles to the new owners.
+   !> The collapsing column with APIC: the affine matrices go with their particles to the new owners (a
+   !> small step: APIC on multilinear shape functions is not stable at the CFL step here, docs/theory.md).
    subroutine test_apic_column_rebalanced(comm)
       type(MPI_Comm), intent(in) :: comm
       type(scene_t) :: scene
       scene = corner_column([4.0_rp, 2.0_rp], 1.0_rp, 'none')
-      scene%run%fixed_dt = 5.0e-4_rp
+      scene%run%fixed_dt = 1.0e-4_rp
       scene%run%transfer = 'apic'
       call compare_with_and_without(comm, scene, 'collapsing column, APIC')
    end subroutine test_apic_column_rebalanced

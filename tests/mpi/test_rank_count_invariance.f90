@@ -82,18 +82,20 @@ contains
       call compare_rank_counts(comm, scene)
    end subroutine test_collapsing_column_3d_rank_invariance
 
-   !> The collapsing columns (2-D, 3-D) with APIC: the affine matrices migrate with their particles.
+   !> The collapsing columns (2-D, 3-D) with APIC: the affine matrices migrate with their particles. A step
+   !> of a fifth of the FLIP/PIC columns': with multilinear shape functions APIC is not stable at the CFL
+   !> step on a free surface (docs/theory.md, "APIC").
    subroutine test_apic_column_rank_invariance(comm)
       type(MPI_Comm), intent(in) :: comm
       type(scene_t) :: scene
       scene = water_scene(2, 0.05_rp, [4.0_rp, 2.0_rp, 0.0_rp], 2.0e6_rp, 9.81_rp)
       call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [1.0_rp, 1.0_rp, 0.0_rp], 2, .false., 0.0_rp)
-      scene%run%fixed_dt = 5.0e-4_rp
+      scene%run%fixed_dt = 1.0e-4_rp
       scene%run%transfer = 'apic'
       call compare_rank_counts(comm, scene, label='2-D, APIC')
       scene = water_scene(3, 0.1_rp, [2.0_rp, 0.6_rp, 1.2_rp], 2.0e6_rp, 9.81_rp)
       call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [0.6_rp, 0.6_rp, 0.6_rp], 2, .false., 0.0_rp)
-      scene%run%fixed_dt = 1.0e-3_rp
+      scene%run%fixed_dt = 2.0e-4_rp
       scene%run%transfer = 'apic'
       call compare_rank_counts(comm, scene, label='3-D, APIC')
    end subroutine test_apic_column_rank_invariance

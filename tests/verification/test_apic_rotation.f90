@@ -1,7 +1,9 @@
 !> A free elastic body spinning without gravity or walls (docs/theory.md "APIC"): with APIC the angular
-!> momentum L = sum_p m_p (x_p x v_p + eps : B_p^T) ([J15] sec. 5.3) is conserved to round-off over
-!> hundreds of steps; with PIC (flip_fraction 0) the transfers lose L = sum_p m_p x_p x v_p. The kinetic
-!> energy of the spinning disk decays far less with APIC than with PIC. On 1, 2 and 4 ranks.
+!> momentum L = sum_p m_p (x_p x v_p + eps : (C_p D_p)^T) ([J15] sec. 5.3) stays within a bound set by
+!> the change of D_p as the particles move on the multilinear grid (each transfer keeps it exactly:
+!> tests/unit/transfer/test_affine_transfer.f90), and does not drift; PIC (flip_fraction 0) loses all of
+!> L = sum_p m_p x_p x v_p. The kinetic energy of the spinning disk decays far less with APIC than with
+!> PIC. On 1, 2 and 4 ranks.
 module test_apic_rotation
    use kinds, only: rp
    use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_SUM
@@ -94,38 +96,38 @@ contains
          solver%particles%v(:, p) = r(1:dim)
       end do
       before = solver%diagnostics()
-      l0 = particle_angular_momentum(solver%particles, comm)
+      l0 = particle_angular_momentum(solver%particles, solver%grid, comm)
       do step = 1, steps
          call solver%advance()
       end do
       after = solver%diagnostics()
-      l1 = particle_angular_momentum(solver%particles, comm)
+      l1 = particle_angular_momentum(solver%particles, solver%grid, comm)
       call assertTrue(after%particles == before%particles .and. after%lost_particles == 0, 'every particle kept')
       result%l_change = norm2(l1 - l0) / norm2(l0)
       result%energy_ratio = after%kinetic_energy / before%kinetic_energy
       call solver%free()
    end function spin
 
-   !> 2-D disk, 500 steps (0.2 s, 0.4 rad): APIC keeps L to 1e-12, PIC loses more than 1e-3.
+   !> 2-D disk, 500 steps (0.2 s, 0.4 rad): APIC keeps L within 5e-3 (measured 2.3e-3), PIC loses over half.
    subroutine test_spinning_disk_keeps_angular_momentum(comm)
       type(MPI_Comm), intent(in) :: comm
       type(spin_result_t) :: apic, pic
       apic = spin(comm, spinning_scene(2, 'apic', 0.95_rp), [0.0_rp, 0.0_rp, 1.0_rp], 500)
       pic = spin(comm, spinning_scene(2, 'flip_pic', 0.0_rp), [0.0_rp, 0.0_rp, 1.0_rp], 500)
       call report(comm, 'disk, 500 steps', apic, pic)
-      call assertLessThanOrEqual(apic%l_change, 1.0e-12_rp, 'APIC: |L - L0| / |L0| after 500 steps')
-      call assertLessThanOrEqual(1.0e-3_rp, pic%l_change, 'PIC loses angular momentum')
+      call assertLessThanOrEqual(apic%l_change, 5.0e-3_rp, 'APIC: |L - L0| / |L0| after 500 steps')
+      call assertLessThanOrEqual(0.5_rp, pic%l_change, 'PIC loses angular momentum')
    end subroutine test_spinning_disk_keeps_angular_momentum
 
-   !> 3-D cube spinning about a tilted axis, 300 steps: every component of L kept with APIC.
+   !> 3-D cube (3 cells wide) spinning about a tilted axis, 300 steps: L within 5e-2 (measured 2.5e-2).
    subroutine test_spinning_box_3d_keeps_angular_momentum(comm)
       type(MPI_Comm), intent(in) :: comm
       type(spin_result_t) :: apic, pic
       apic = spin(comm, spinning_scene(3, 'apic', 0.95_rp), [0.3_rp, 0.5_rp, 0.8_rp], 300)
       pic = spin(comm, spinning_scene(3, 'flip_pic', 0.0_rp), [0.3_rp, 0.5_rp, 0.8_rp], 300)
       call report(comm, 'cube 3-D, 300 steps', apic, pic)
-      call assertLessThanOrEqual(apic%l_change, 1.0e-12_rp, 'APIC 3-D: |L - L0| / |L0| after 300 steps')
-      call assertLessThanOrEqual(1.0e-3_rp, pic%l_change, 'PIC 3-D loses angular momentum')
+      call assertLessThanOrEqual(apic%l_change, 5.0e-2_rp, 'APIC 3-D: |L - L0| / |L0| after 300 steps')
+      call assertLessThanOrEqual(0.5_rp, pic%l_change, 'PIC 3-D loses angular momentum')
    end subroutine test_spinning_box_3d_keeps_angular_momentum
 
    !> The disk's kinetic energy after 1500 steps (0.6 s): APIC loses less than a tenth of what PIC loses.
@@ -139,6 +141,8 @@ contains
       call report(comm, 'disk, 1500 steps', apic, pic, flip)
       call assertLessThanOrEqual(1.0_rp - apic%energy_ratio, 0.1_rp * (1.0_rp - pic%energy_ratio), &
                                  'APIC loses < 1/10 of the kinetic energy PIC loses')
+      ! no drift: after three times the steps the change of L is still within the 500-step bound
+      call assertLessThanOrEqual(apic%l_change, 5.0e-3_rp, 'APIC: |L - L0| / |L0| after 1500 steps')
    end subroutine test_spinning_disk_kinetic_energy
 
    !> One line per transfer on rank 0: the numbers docs/speed-accuracy.md quotes.

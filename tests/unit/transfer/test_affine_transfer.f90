@@ -1,6 +1,6 @@
 !> APIC's transfers (src/transfer/grid_transfer_kernels.inc, docs/theory.md "APIC"): an affine velocity
-!> field survives P2G and G2P exactly; P2G keeps the angular momentum sum m_p (x_p x v_p + eps : B_p^T) on
-!> the grid. On 1, 2 and 4 ranks (ghost-node sums).
+!> field survives P2G and G2P exactly; each transfer keeps the angular momentum
+!> sum m_p (x_p x v_p + eps : (C_p D_p)^T) exactly. On 1, 2 and 4 ranks (ghost-node sums).
 module test_affine_transfer
    use kinds, only: rp
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_SUM, MPI_MAX
@@ -36,21 +36,6 @@ contains
       call assertEqual(dim * dim, solver%particles%n_affine, 'the particles carry B_p')
    end subroutine make_solver
 
-   !> D_p of particle p from its fractional position in its cell (as the kernels locate it).
-   function particle_d(solver, p) result(dp)
-      type(solver_t), intent(in) :: solver
-      integer, intent(in) :: p
-      real(rp) :: dp(solver%grid%dim, solver%grid%dim), s
-      integer :: k, c
-      dp = 0.0_rp
-      do k = 1, solver%grid%dim
-         s = (solver%particles%x(k, p) - solver%grid%origin(k)) * solver%grid%inv_h
-         c = min(floor(s), solver%grid%global_cells(k) - 1)
-         s = s - real(c, rp)
-         dp(k, k) = s * (1.0_rp - s) * solver%grid%h**2
-      end do
-   end function particle_d
-
    subroutine test_affine_field_round_trip_2d(comm)
       type(MPI_Comm), intent(in) :: comm
       call check_affine_round_trip(comm, 2)
@@ -61,8 +46,8 @@ contains
       call check_affine_round_trip(comm, 3)
    end subroutine test_affine_field_round_trip_3d
 
-   !> v(x) = v0 + A x on the particles with B_p = A D_p (C_p = A): P2G gives every node with mass exactly
-   !> v(x_i); G2P from the nodal field v(x_i) gives back v_p = v(x_p), B_p = A D_p and d_p = sym A.
+   !> v(x) = v0 + A x on the particles with C_p = A: P2G gives every node with mass exactly v(x_i); G2P from
+   !> the nodal field v(x_i) gives back v_p = v(x_p), C_p = A and d_p = sym A.
    subroutine check_affine_round_trip(comm, dim)
       type(MPI_Comm), intent(in) :: comm
       integer, intent(in) :: dim
@@ -76,7 +61,7 @@ contains
       call make_solver(comm, dim, solver)
       do p = 1, solver%particles%count
          solver%particles%v(:, p) = v0 + matmul(a, solver%particles%x(:, p))
-         solver%particles%affine(:, p) = reshape(matmul(a, particle_d(solver, p)), [dim * dim])
+         solver%particles%affine(:, p) = reshape(a, [dim * dim])
       end do
       call particles_to_grid(solver%grid, solver%particles, solver%gravity)
       call sum_shared_nodes(solver%domain, solver%grid, solver%grid%accumulated)
@@ -94,8 +79,7 @@ contains
                              compute_strain=.true., update_position=.false.)
       do p = 1, solver%particles%count
          worst(2) = max(worst(2), maxval(abs(solver%particles%v(:, p) - (v0 + matmul(a, solver%particles%x(:, p))))))
-         call assertEqual(reshape(matmul(a, particle_d(solver, p)), [dim * dim]), solver%particles%affine(:, p), &
-                          1.0e-15_rp, 'G2P: B_p = A D_p')
+         call assertEqual(reshape(a, [dim * dim]), solver%particles%affine(:, p), 1.0e-12_rp, 'G2P: C_p = A')
          call assertEqual(a(1, 1), solver%particles%strain_rate(1, p), 1.0e-13_rp, 'G2P: d_xx = A_xx')
       end do
       call MPI_Allreduce(MPI_IN_PLACE, worst, 2, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
@@ -114,21 +98,22 @@ contains
       call check_p2g_angular_momentum(comm, 3)
    end subroutine test_p2g_keeps_angular_momentum_3d
 
-   !> Arbitrary (non-affine) v_p and B_p: sum_i x_i x P_i over the nodes equals the particles'
-   !> sum m_p (x_p x v_p + eps : B_p^T) ([J15] sec. 5.3), and P2G's linear momentum equals sum m_p v_p.
+   !> Arbitrary (non-affine) v_p and C_p: sum_i x_i x P_i over the nodes after P2G equals the particles'
+   !> sum m_p (x_p x v_p + eps : (C_p D_p)^T) ([J15] sec. 5.3), and P2G's linear momentum sum m_p v_p. Then
+   !> G2P from these nodal velocities (v_i = P_i / m_i) gives the particles the same angular momentum back.
    subroutine check_p2g_angular_momentum(comm, dim)
       type(MPI_Comm), intent(in) :: comm
       integer, intent(in) :: dim
       type(solver_t) :: solver
-      real(rp) :: l_particles(3), node_sums(6), x(3), pm(3), s
+      real(rp) :: l_particles(3), node_sums(6), x(3), pm(3), s, l_back(3)
       integer :: p, i, k, mom
       call make_solver(comm, dim, solver)
       do p = 1, solver%particles%count
          s = real(solver%particles%id(p), rp)
          solver%particles%v(:, p) = [(sin(1.3_rp * s + k), k = 1, dim)]
-         solver%particles%affine(:, p) = [(0.05_rp * cos(0.7_rp * s * k + k), k = 1, dim * dim)]
+         solver%particles%affine(:, p) = [(2.0_rp * cos(0.7_rp * s * k + k), k = 1, dim * dim)]
       end do
-      l_particles = particle_angular_momentum(solver%particles, comm)
+      l_particles = particle_angular_momentum(solver%particles, solver%grid, comm)
       call particles_to_grid(solver%grid, solver%particles, solver%gravity)
       call sum_shared_nodes(solver%domain, solver%grid, solver%grid%accumulated)
       mom = solver%grid%row_momentum
@@ -153,6 +138,17 @@ contains
       end do
       call MPI_Allreduce(MPI_IN_PLACE, pm, 3, MPI_DOUBLE_PRECISION, MPI_SUM, comm)
       call assertEqual(pm, node_sums(4:6), 1.0e-13_rp * maxval(abs(pm)), 'linear momentum (the affine part adds none)')
+      ! G2P at the same positions (no move): v_p = sum N v_i, C_p = sum v_i (x) grad N give L back
+      do i = 1, solver%grid%node_count
+         solver%grid%velocity(:, i) = 0.0_rp
+         if (solver%grid%accumulated(row_mass, i) > 0.0_rp) solver%grid%velocity(:, i) = &
+            solver%grid%accumulated(mom:mom + dim - 1, i) / solver%grid%accumulated(row_mass, i)
+         solver%grid%velocity_increment(:, i) = 0.0_rp
+      end do
+      call grid_to_particles(solver%grid, solver%particles, 0.0_rp, 0.95_rp, 1.0_rp, update_velocity=.true., &
+                             compute_strain=.false., update_position=.false.)
+      l_back = particle_angular_momentum(solver%particles, solver%grid, comm)
+      call assertEqual(l_particles, l_back, 1.0e-12_rp * maxval(abs(l_particles)), 'G2P gives the angular momentum back')
       call solver%free()
    end subroutine check_p2g_angular_momentum
 end module test_affine_transfer
