@@ -30,16 +30,30 @@ contains
       real(rp), intent(in) :: gravity(:)
       integer, intent(in), optional :: field(:), field_row
       grid%accumulated = 0.0_rp
-      if (present(field)) then
-         if (grid%dim == 2) then
-            call particles_to_grid_fields_2d(grid, particles, gravity, field, field_row)
+      if (particles%n_affine > 0) then
+         if (present(field)) then
+            if (grid%dim == 2) then
+               call particles_to_grid_fields_apic_2d(grid, particles, gravity, field, field_row)
+            else
+               call particles_to_grid_fields_apic_3d(grid, particles, gravity, field, field_row)
+            end if
+         else if (grid%dim == 2) then
+            call particles_to_grid_apic_2d(grid, particles, gravity)
          else
-            call particles_to_grid_fields_3d(grid, particles, gravity, field, field_row)
+            call particles_to_grid_apic_3d(grid, particles, gravity)
          end if
-      else if (grid%dim == 2) then
-         call particles_to_grid_2d(grid, particles, gravity)
       else
-         call particles_to_grid_3d(grid, particles, gravity)
+         if (present(field)) then
+            if (grid%dim == 2) then
+               call particles_to_grid_fields_2d(grid, particles, gravity, field, field_row)
+            else
+               call particles_to_grid_fields_3d(grid, particles, gravity, field, field_row)
+            end if
+         else if (grid%dim == 2) then
+            call particles_to_grid_2d(grid, particles, gravity)
+         else
+            call particles_to_grid_3d(grid, particles, gravity)
+         end if
       end if
    end subroutine particles_to_grid
 
@@ -56,16 +70,32 @@ contains
       integer, intent(in), optional :: field(:)
       real(rp), intent(in), optional :: velocity(:, :), increment(:, :)
       momentum = 0.0_rp
-      if (present(field)) then
-         if (grid%dim == 2) then
-            call momentum_to_grid_fields_2d(grid, particles, flip_fraction, momentum, field, velocity, increment)
+      if (particles%n_affine > 0) then
+         if (present(field)) then
+            if (grid%dim == 2) then
+               call momentum_to_grid_fields_apic_2d(grid, particles, momentum, field, velocity, &
+                                                    increment)
+            else
+               call momentum_to_grid_fields_apic_3d(grid, particles, momentum, field, velocity, &
+                                                    increment)
+            end if
+         else if (grid%dim == 2) then
+            call momentum_to_grid_apic_2d(grid, particles, momentum)
          else
-            call momentum_to_grid_fields_3d(grid, particles, flip_fraction, momentum, field, velocity, increment)
+            call momentum_to_grid_apic_3d(grid, particles, momentum)
          end if
-      else if (grid%dim == 2) then
-         call momentum_to_grid_2d(grid, particles, flip_fraction, momentum)
       else
-         call momentum_to_grid_3d(grid, particles, flip_fraction, momentum)
+         if (present(field)) then
+            if (grid%dim == 2) then
+               call momentum_to_grid_fields_2d(grid, particles, flip_fraction, momentum, field, velocity, increment)
+            else
+               call momentum_to_grid_fields_3d(grid, particles, flip_fraction, momentum, field, velocity, increment)
+            end if
+         else if (grid%dim == 2) then
+            call momentum_to_grid_2d(grid, particles, flip_fraction, momentum)
+         else
+            call momentum_to_grid_3d(grid, particles, flip_fraction, momentum)
+         end if
       end if
    end subroutine update_velocity_and_remap
 
@@ -97,7 +127,25 @@ contains
       if (present(compute_spin)) spin = compute_strain .and. compute_spin
       lo = 0.0_rp
       hi = 0.0_rp
-      if (present(field)) then
+      if (particles%n_affine > 0) then
+         if (present(field)) then
+            if (grid%dim == 2) then
+               call grid_to_particles_fields_apic_2d(grid, particles, dt, theta, update_velocity, &
+                                                     compute_strain, spin, update_position, lo(1:2), hi(1:2), field, &
+                                                     velocity, increment, strain_velocity)
+            else
+               call grid_to_particles_fields_apic_3d(grid, particles, dt, theta, update_velocity, &
+                                                     compute_strain, spin, update_position, lo, hi, field, velocity, &
+                                                     increment, strain_velocity)
+            end if
+         else if (grid%dim == 2) then
+            call grid_to_particles_apic_2d(grid, particles, dt, theta, update_velocity, compute_strain, &
+                                           spin, update_position, lo(1:2), hi(1:2), strain_velocity)
+         else
+            call grid_to_particles_apic_3d(grid, particles, dt, theta, update_velocity, compute_strain, &
+                                           spin, update_position, lo, hi, strain_velocity)
+         end if
+      else if (present(field)) then
          if (grid%dim == 2) then
             call grid_to_particles_fields_2d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
                                              spin, update_position, lo(1:2), hi(1:2), field, velocity, increment, &
@@ -165,6 +213,9 @@ contains
 ! "APIC"). For B-splines it is not grad N_a: a B-spline stencil puts d(j, a) n(a) / D here (D = h^2/4
 ! quadratic, h^2/3 cubic; d(:, a) = x_a - x_p from OFFSETS, which G2P and M2G then need too).
 #define AFFINE_GRADIENT(j, a) g(j, a)
+
+! The FLIP/PIC kernels take the blend alpha = flip_fraction, APIC's none
+#define BLEND flip_fraction,
 
 ! Single-field kernels: nodal velocities from the grid
 #define VEL(i, node) grid%velocity(i, node)
@@ -242,5 +293,83 @@ contains
 #define P2G particles_to_grid_fields_3d
 #define M2G momentum_to_grid_fields_3d
 #define G2P grid_to_particles_fields_3d
+#include "grid_transfer_kernels.inc"
+#undef KERNEL_DIM
+#undef SHAPE
+#undef LOCATE
+#undef OFFSETS
+#undef P2G
+#undef M2G
+#undef G2P
+
+! APIC's kernels (AFFINE): the same, with the affine terms; the FLIP/PIC kernels above stay untouched
+#define AFFINE
+#undef BLEND
+#define BLEND
+#undef FIELDS
+#undef VEL
+#undef INC
+#define VEL(i, node) grid%velocity(i, node)
+#define INC(i, node) grid%velocity_increment(i, node)
+#define KERNEL_DIM 2
+#define SHAPE shape_2d
+#define LOCATE locate_2d
+#define OFFSETS node_offsets_2d
+#define P2G particles_to_grid_apic_2d
+#define M2G momentum_to_grid_apic_2d
+#define G2P grid_to_particles_apic_2d
+#include "grid_transfer_kernels.inc"
+#undef KERNEL_DIM
+#undef SHAPE
+#undef LOCATE
+#undef OFFSETS
+#undef P2G
+#undef M2G
+#undef G2P
+
+#define KERNEL_DIM 3
+#define SHAPE shape_3d
+#define LOCATE locate_3d
+#define OFFSETS node_offsets_3d
+#define P2G particles_to_grid_apic_3d
+#define M2G momentum_to_grid_apic_3d
+#define G2P grid_to_particles_apic_3d
+#include "grid_transfer_kernels.inc"
+#undef KERNEL_DIM
+#undef SHAPE
+#undef LOCATE
+#undef OFFSETS
+#undef P2G
+#undef M2G
+#undef G2P
+#undef VEL
+#undef INC
+
+#define FIELDS
+#define VEL(i, node) velocity(o + (i), node)
+#define INC(i, node) increment(o + (i), node)
+#define KERNEL_DIM 2
+#define SHAPE shape_2d
+#define LOCATE locate_2d
+#define OFFSETS node_offsets_2d
+#define P2G particles_to_grid_fields_apic_2d
+#define M2G momentum_to_grid_fields_apic_2d
+#define G2P grid_to_particles_fields_apic_2d
+#include "grid_transfer_kernels.inc"
+#undef KERNEL_DIM
+#undef SHAPE
+#undef LOCATE
+#undef OFFSETS
+#undef P2G
+#undef M2G
+#undef G2P
+
+#define KERNEL_DIM 3
+#define SHAPE shape_3d
+#define LOCATE locate_3d
+#define OFFSETS node_offsets_3d
+#define P2G particles_to_grid_fields_apic_3d
+#define M2G momentum_to_grid_fields_apic_3d
+#define G2P grid_to_particles_fields_apic_3d
 #include "grid_transfer_kernels.inc"
 end module grid_transfer
