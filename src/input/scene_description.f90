@@ -32,7 +32,11 @@ module scene_description
       character(len=path_len) :: output_dir = 'output'
       logical :: overwrite = .false.          !< allow replacing a previous run in output_dir
       character(len=name_len) :: update_scheme = 'MUSL'  !< 'MUSL' (default) or 'USL'
+      !> velocity transfer: 'flip_pic' (the FLIP/PIC blend, default) or 'apic' (affine, docs/theory.md)
+      character(len=name_len) :: transfer = 'flip_pic'
       real(rp) :: flip_fraction = 0.95_rp     !< 1: pure FLIP, 0: pure PIC (default: docs/theory.md)
+      !> the scene file or an override assigns flip_fraction: refused with 'apic', which has no blend
+      logical :: flip_fraction_given = .false.
       real(rp) :: theta = 1.0_rp              !< theta of the nodal velocity used for kinematics
       integer(i8) :: max_steps = huge(1_i8)   !< stop after this many steps
       real(rp) :: progress_interval = 5.0_rp  !< wall seconds between progress lines on stderr; <= 0: none

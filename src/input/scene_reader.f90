@@ -69,6 +69,7 @@ module scene_reader
       variable_info_t('run', 'output_dir', 'string', .false.), &
       variable_info_t('run', 'overwrite', 'logical', .false.), &
       variable_info_t('run', 'update_scheme', 'string', .false.), &
+      variable_info_t('run', 'transfer', 'string', .false.), &
       variable_info_t('run', 'flip_fraction', 'real', .false.), &
       variable_info_t('run', 'theta', 'real', .false.), &
       variable_info_t('run', 'max_steps', 'integer', .false.), &
@@ -871,14 +872,14 @@ contains
       character(len=*), intent(in) :: text
       real(rp) :: end_time, cfl, dt, output_interval, flip_fraction, theta, progress_interval, floor_size, &
                   checkpoint_interval_wall, speed_limit, rebalance_threshold, load_interval
-      character(len=text_len) :: output_dir, update_scheme, field_precision, particle_fields
+      character(len=text_len) :: output_dir, update_scheme, field_precision, particle_fields, transfer
       logical :: overwrite, particle_output, grid_output
       integer(i8) :: max_steps, checkpoint_interval_steps
       integer :: checkpoints_kept, rebalance_interval
-      namelist /run/ end_time, cfl, dt, output_interval, output_dir, overwrite, update_scheme, flip_fraction, &
-         theta, max_steps, progress_interval, floor_size, particle_output, grid_output, checkpoint_interval_steps, &
-         checkpoint_interval_wall, checkpoints_kept, speed_limit, rebalance_threshold, rebalance_interval, &
-         load_interval, field_precision, particle_fields
+      namelist /run/ end_time, cfl, dt, output_interval, output_dir, overwrite, update_scheme, transfer, &
+         flip_fraction, theta, max_steps, progress_interval, floor_size, particle_output, grid_output, &
+         checkpoint_interval_steps, checkpoint_interval_wall, checkpoints_kept, speed_limit, rebalance_threshold, &
+         rebalance_interval, load_interval, field_precision, particle_fields
 
       end_time = control%end_time
       cfl = control%cfl
@@ -887,7 +888,9 @@ contains
       output_dir = control%output_dir
       overwrite = control%overwrite
       update_scheme = control%update_scheme
-      flip_fraction = control%flip_fraction
+      transfer = control%transfer
+      ! huge marks "not assigned here": with APIC a flip_fraction the scene gives is refused, not ignored
+      flip_fraction = huge(1.0_rp)
       theta = control%theta
       max_steps = control%max_steps
       progress_interval = control%progress_interval
@@ -906,6 +909,7 @@ contains
       read (text, nml=run, iostat=ios, iomsg=message)
       call take_text('output_dir', output_dir, control%output_dir, ios, message)
       call take_text('update_scheme', update_scheme, control%update_scheme, ios, message, fold='upper')
+      call take_text('transfer', transfer, control%transfer, ios, message, fold='lower')
       call take_text('field_precision', field_precision, control%field_precision, ios, message, fold='lower')
       call take_text('particle_fields', particle_fields, control%particle_fields, ios, message)
       if (ios /= 0) return
@@ -914,7 +918,10 @@ contains
       control%fixed_dt = dt
       control%output_interval = output_interval
       control%overwrite = overwrite
-      control%flip_fraction = flip_fraction
+      if (flip_fraction < huge(1.0_rp) .or. .not. ieee_is_finite(flip_fraction)) then
+         control%flip_fraction = flip_fraction
+         control%flip_fraction_given = .true.
+      end if
       control%theta = theta
       control%max_steps = max_steps
       control%progress_interval = progress_interval

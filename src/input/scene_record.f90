@@ -6,7 +6,8 @@
 !> array whole; the text reads back as a scene file giving the same scene. The same text is the
 !> output folder's scene.nml and the `scene` attribute of every HDF5 file (provenance).
 !> `&run overwrite` is left out: it is an action on the output folder, not part of the scene, and a run
-!> started again from the text must not replace results silently.
+!> started again from the text must not replace results silently. `&run flip_fraction` is left out with
+!> `transfer = 'apic'`, which refuses it.
 module scene_record
    use kinds, only: rp
    use scene_description, only: scene_t
@@ -73,6 +74,8 @@ contains
       text = '&'//group
       do v = 1, size(names)
          if (group == 'run' .and. names(v) == 'overwrite') cycle
+         ! APIC has no blend: a flip_fraction in the text would make it a scene that is refused
+         if (group == 'run' .and. names(v) == 'flip_fraction' .and. scene%run%transfer == 'apic') cycle
          text = text//new_line('a')//'   '//trim(names(v))//' = '//value_text(scene, group, k, trim(names(v)))
       end do
       text = text//new_line('a')//'/'
@@ -132,6 +135,8 @@ contains
             text = quoted(run%output_dir)
          case ('update_scheme')
             text = quoted(run%update_scheme)
+         case ('transfer')
+            text = quoted(run%transfer)
          case ('flip_fraction')
             text = real_text(run%flip_fraction)
          case ('theta')

@@ -50,6 +50,8 @@ module scene_validation
    character(len=*), parameter, public :: shape_function_keywords(*) = [character(len=8) :: 'linear', 'bspline2']
    !> Accepted `&run update_scheme=` keywords (stored upper case).
    character(len=*), parameter, public :: update_scheme_keywords(*) = [character(len=4) :: 'USL', 'MUSL']
+   !> Accepted `&run transfer=` keywords (stored lower case).
+   character(len=*), parameter, public :: transfer_keywords(*) = [character(len=8) :: 'flip_pic', 'apic']
    !> Accepted `&box_walls` keywords (stored lower case).
    character(len=*), parameter, public :: wall_keywords(*) = [character(len=8) :: wall_none, wall_slip, wall_no_slip, &
                                                               wall_friction]
@@ -516,6 +518,14 @@ contains
       if (all(run%update_scheme /= update_scheme_keywords)) then
          call status%fail(where//': variable update_scheme must be one of '//quoted_list(update_scheme_keywords)// &
                           ", got '"//trim(run%update_scheme)//"'")
+      end if
+      if (all(run%transfer /= transfer_keywords)) then
+         call status%fail(where//': variable transfer must be one of '//quoted_list(transfer_keywords)// &
+                          ", got '"//trim(run%transfer)//"'")
+      else if (run%transfer == 'apic' .and. run%flip_fraction_given) then
+         ! a blend the user asked for must not be dropped without a word
+         call status%fail(where//": variable flip_fraction has no effect with transfer = 'apic' (APIC has no FLIP/PIC "// &
+                          "blend); remove it")
       end if
       call check_real(where, 'flip_fraction', run%flip_fraction, status, at_least=0.0_rp, at_most=1.0_rp)
       call check_real(where, 'theta', run%theta, status, greater_than=0.0_rp, at_most=1.0_rp)

@@ -1,8 +1,9 @@
 !> Checkpoints: the full state a run needs to continue, in one HDF5 file written by all ranks
 !> (docs/output.md, "Checkpoints and restart").
 !>
-!> Saved: every particle's persistent state (position, velocity, mass, density, sbar, material, id) in
-!> each rank's order, the rank each slab came from, time, step, the next dt, the per-rank counters
+!> Saved: every particle's persistent state (position, velocity, mass, density, sbar, material, id, and
+!> with APIC the affine matrix C_p as /particles/affine) in each rank's order, the rank each slab came
+!> from, time, step, the next dt, the per-rank counters
 !> (lost particles, wall corrections), the empty-node mass tolerance, and the run's progress (next
 !> output time, the outputs written so far, the checkpoint number) and the decomposition (rank count
 !> and slab boundaries, which load balancing may have moved). Restarting on the same number of ranks
@@ -63,6 +64,7 @@ module checkpoint
       integer, allocatable :: cuts(:)
       integer :: n = 0                            !< particles this rank read
       real(rp), allocatable :: x(:, :), v(:, :), mass(:), density(:), sbar(:, :)
+      real(rp), allocatable :: affine(:, :)       !< APIC's C_p (dim**2, p); zero size without APIC
       integer, allocatable :: material(:)
       integer(i8), allocatable :: id(:)
    end type saved_state_t
@@ -202,6 +204,7 @@ contains
          call file%write_slab('particles/sbar', slab, particles%sbar(:, 1:m), status)
          call file%write_slab('particles/material', slab, particles%material(1:m), status)
          call file%write_slab('particles/id', slab, particles%id(1:m), status)
+         if (particles%n_affine > 0) call file%write_slab('particles/affine', slab, particles%affine(:, 1:m), status)
       end associate
       one = distributed_slab(solver%domain%comm, 1)
       call file%create_group('ranks', status)
@@ -390,6 +393,13 @@ contains
       call file%read_slab('particles/sbar', slab, state%sbar, status)
       call file%read_slab('particles/material', slab, state%material, status)
       call file%read_slab('particles/id', slab, state%id, status)
+      ! APIC's C_p; zero (the velocity uniform around each particle) if the run before had no APIC, which
+      ! only --allow-scene-change lets a restart change
+      allocate (state%affine(merge(scene%grid%dim**2, 0, scene%run%transfer == 'apic'), m))
+      state%affine = 0.0_rp
+      if (size(state%affine, 1) > 0) then
+         if (file%has('particles/affine')) call file%read_slab('particles/affine', slab, state%affine, status)
+      end if
    end subroutine read_particles
 
    !> The checkpoint was accepted: its decomposition (same ranks), particles, time, step and counters
@@ -407,10 +417,11 @@ contains
          call solver%set_layout(reshape(state%cuts, shape(solver%domain%cuts)), status)
          if (.not. status%ok) return
       end if
-      call solver%particles%init(scene%grid%dim, size(scene%materials), max(state%n, 1024))
+      call solver%particles%init(scene%grid%dim, size(scene%materials), max(state%n, 1024), &
+                                 affine=size(state%affine, 1) > 0)
       do p = 1, state%n
          call solver%particles%add(state%x(:, p), state%v(:, p), state%mass(p), state%density(p), state%sbar(:, p), &
-                                   state%material(p), state%id(p))
+                                   state%material(p), state%id(p), state%affine(:, p))
       end do
       call solver%check_particle_memory(status)
       if (.not. status%ok) return

@@ -1,7 +1,8 @@
 !> The material points a rank owns, as a structure of arrays (style.md, lesson 5).
 !>
 !> Persistent state: position, velocity, mass, density, mass-specific stress sbar = sigma / rho
-!> (algorithms.md section 1), material, global id. Scratch per step: the (filtered) rate of deformation
+!> (algorithms.md section 1), material, global id, and with APIC (`&run transfer = 'apic'`) the affine
+!> matrix C_p (docs/theory.md, "APIC"; not allocated otherwise: n_affine = 0). Scratch per step: the (filtered) rate of deformation
 !> and the spin. After `sort_by_material_and_cell` the particles of material m occupy the contiguous
 !> range material_first(m):material_last(m), ordered by cell, so material updates and cell sums run
 !> over contiguous slices.
@@ -20,12 +21,15 @@ module particle_set
 
    type, public :: particle_set_t
       integer :: dim = 2, n_sigma = 4, n_spin = 1, n_materials = 1
+      integer :: n_affine = 0                       !< dim**2 with APIC, else 0
       integer :: count = 0                          !< particles held
       real(rp), allocatable :: x(:, :)              !< position (dim, p), grid frame [m]
       real(rp), allocatable :: v(:, :)              !< velocity (dim, p) [m/s]
       real(rp), allocatable :: mass(:)              !< mass [kg] (per unit thickness in 2-D)
       real(rp), allocatable :: density(:)           !< current density [kg/m^3]
       real(rp), allocatable :: sbar(:, :)           !< mass-specific stress (n_sigma, p) [Pa m^3/kg]
+      !> APIC's C_p = sum_i v_i (x) grad N_ip = B_p D_p^-1, column-major (n_affine, p) [1/s]
+      real(rp), allocatable :: affine(:, :)
       integer, allocatable :: material(:)           !< material index
       integer(i8), allocatable :: id(:)             !< globally unique id
       integer, allocatable :: cell(:)               !< local cell index at x^n (set by the sort)
@@ -47,12 +51,18 @@ module particle_set
 
 contains
 
-   subroutine particles_init(self, dim, n_materials, capacity)
+   !> An empty set; `affine` (default .false.): carry APIC's affine matrix per particle.
+   subroutine particles_init(self, dim, n_materials, capacity, affine)
       class(particle_set_t), intent(inout) :: self
       integer, intent(in) :: dim, n_materials, capacity
+      logical, intent(in), optional :: affine
       self%dim = dim
       self%n_sigma = n_components(dim)
       self%n_spin = n_spin(dim)
+      self%n_affine = 0
+      if (present(affine)) then
+         if (affine) self%n_affine = dim * dim
+      end if
       self%n_materials = n_materials
       self%count = 0
       call self%allocation%reset()
@@ -71,13 +81,14 @@ contains
       allocate (self%x(self%dim, capacity), self%v(self%dim, capacity), self%mass(capacity), &
                 self%density(capacity), self%sbar(self%n_sigma, capacity), self%material(capacity), &
                 self%id(capacity), self%cell(capacity), self%strain_rate(self%n_sigma, capacity), &
-                self%spin(self%n_spin, capacity), stat=stat)
+                self%spin(self%n_spin, capacity), self%affine(self%n_affine, capacity), stat=stat)
       if (stat == 0) return
       call no_memory(self, capacity)
       ! an empty set, so that the caller can still report and stop
       call free_arrays(self)
       allocate (self%x(self%dim, 0), self%v(self%dim, 0), self%mass(0), self%density(0), self%sbar(self%n_sigma, 0), &
-                self%material(0), self%id(0), self%cell(0), self%strain_rate(self%n_sigma, 0), self%spin(self%n_spin, 0))
+                self%material(0), self%id(0), self%cell(0), self%strain_rate(self%n_sigma, 0), self%spin(self%n_spin, 0), &
+                self%affine(self%n_affine, 0))
    end subroutine allocate_arrays
 
    !> Record that room for `capacity` particles could not be allocated.
@@ -92,7 +103,7 @@ contains
    !> Bytes of the particle arrays per particle.
    pure integer(i8) function particle_bytes(self)
       type(particle_set_t), intent(in) :: self
-      particle_bytes = 8_i8 * (2 * self%dim + 2 + 2 * self%n_sigma + self%n_spin + 1) + 4_i8 * 2
+      particle_bytes = 8_i8 * (2 * self%dim + 2 + 2 * self%n_sigma + self%n_spin + self%n_affine + 1) + 4_i8 * 2
    end function particle_bytes
 
    subroutine free_arrays(self)
@@ -108,6 +119,7 @@ contains
       if (allocated(self%cell)) deallocate (self%cell)
       if (allocated(self%strain_rate)) deallocate (self%strain_rate)
       if (allocated(self%spin)) deallocate (self%spin)
+      if (allocated(self%affine)) deallocate (self%affine)
    end subroutine free_arrays
 
    !> Make room for at least `capacity` particles, keeping the first `count`.
@@ -133,6 +145,7 @@ contains
       if (ok) ok = reorder_real1(self%mass, dest, capacity)
       if (ok) ok = reorder_real1(self%density, dest, capacity)
       if (ok) ok = reorder_real2(self%sbar, dest, capacity)
+      if (ok) ok = reorder_real2(self%affine, dest, capacity)
       if (ok) ok = reorder_int1(self%material, dest, capacity)
       if (ok) ok = reorder_int1(self%cell, dest, capacity)
       if (ok) ok = reorder_i8(self%id, dest, capacity)
@@ -210,7 +223,7 @@ contains
    !> Reals needed to carry one particle's persistent state between ranks.
    pure integer function particles_record_size(self)
       class(particle_set_t), intent(in) :: self
-      particles_record_size = 2 * self%dim + 2 + self%n_sigma + 2
+      particles_record_size = 2 * self%dim + 2 + self%n_sigma + 2 + self%n_affine
    end function particles_record_size
 
    !> Persistent state of particle p as reals (ids travel bit-for-bit through transfer()).
@@ -228,6 +241,7 @@ contains
       record(2 * d + 3:2 * d + 2 + s) = self%sbar(:, p)
       record(2 * d + 3 + s) = real(self%material(p), rp)
       record(2 * d + 4 + s) = transfer(self%id(p), 1.0_rp)
+      record(2 * d + 5 + s:2 * d + 4 + s + self%n_affine) = self%affine(:, p)
    end subroutine particles_pack_record
 
    !> Append one particle from a record made by pack_record.
@@ -238,15 +252,18 @@ contains
       d = self%dim
       s = self%n_sigma
       call self%add(record(1:d), record(d + 1:2 * d), record(2 * d + 1), record(2 * d + 2), &
-                    record(2 * d + 3:2 * d + 2 + s), nint(record(2 * d + 3 + s)), transfer(record(2 * d + 4 + s), 1_i8))
+                    record(2 * d + 3:2 * d + 2 + s), nint(record(2 * d + 3 + s)), transfer(record(2 * d + 4 + s), 1_i8), &
+                    record(2 * d + 5 + s:2 * d + 4 + s + self%n_affine))
    end subroutine particles_append_record
 
    !> Append one particle given its persistent state (dropped if the arrays cannot grow: see allocation).
-   subroutine particles_add(self, x, v, mass, density, sbar, material, id)
+   !> `affine`: its C_p with APIC (default zero: a uniform velocity, as seeding and inflow create).
+   subroutine particles_add(self, x, v, mass, density, sbar, material, id, affine)
       class(particle_set_t), intent(inout) :: self
       real(rp), intent(in) :: x(:), v(:), mass, density, sbar(:)
       integer, intent(in) :: material
       integer(i8), intent(in) :: id
+      real(rp), intent(in), optional :: affine(:)
       integer :: p
       if (.not. self%allocation%ok) return      ! no memory: the run stops at the end of the step
       if (self%count == size(self%mass)) then
@@ -263,6 +280,9 @@ contains
       self%material(p) = material
       self%id(p) = id
       self%cell(p) = 0
+      if (self%n_affine == 0) return
+      self%affine(:, p) = 0.0_rp
+      if (present(affine)) self%affine(:, p) = affine
    end subroutine particles_add
 
    !> Copy the persistent state of particle `from` into slot `to` (compaction after removal).
@@ -277,6 +297,7 @@ contains
       self%material(to) = self%material(from)
       self%id(to) = self%id(from)
       self%cell(to) = self%cell(from)
+      self%affine(:, to) = self%affine(:, from)
    end subroutine particles_copy_particle
 
    !> Current volume m / rho of particle p (area per unit thickness in 2-D).

@@ -5,7 +5,7 @@
 !>   2. nodal update v^{n+1} = v^n + dt f / m, wall constraints (eq. 14), dv and v^{n+theta}; with &contact
 !>      per velocity field, the bodies' fields meeting at a node by contact (body_contact)
 !>   3. stabilization schemes bin their cells at x^n
-!>   4. grid -> particles: L_p, FLIP/PIC velocity, positions (MUSL: re-map before L)
+!>   4. grid -> particles: L_p, FLIP/PIC or APIC velocity, positions (MUSL: re-map before L)
 !>   5. filter part A (d -> d~), constitutive update per material, filter part B (sbar -> sbar~)
 !>   6. wall safeguard, inflow, migration to owning ranks, sort by (material, cell), next dt.
 !>   7. the active region follows the particles (active_region): a new layout when they near its edge.
@@ -145,7 +145,7 @@ contains
       call self%bodies%init(scene, self%materials, frame, self%gravity)
       call self%contact%init(scene, self%bodies, size(self%materials))
 
-      call self%particles%init(scene%grid%dim, size(scene%materials), 1024)
+      call self%particles%init(scene%grid%dim, size(scene%materials), 1024, affine=scene%run%transfer == 'apic')
       seed = .true.
       if (present(seed_particles)) seed = seed_particles
       if (seed) call seed_bodies(scene, self%grid, self%domain, self%particles)

@@ -1,9 +1,11 @@
 !> Particle-grid transfers of the explicit MPM step (algorithms.md section 1.2, steps 1, 3 and 7).
 !>
-!> The kernels are written once, in grid_transfer_kernels.inc, and instantiated for 2-D and 3-D and for
-!> each shape function (multilinear, quadratic B-spline) with the dimension and the stencil as
-!> compile-time constants, so that the loops over axes and stencil nodes unroll. The public routines pick
-!> the instance from grid%dim and grid%shape (the scene's &grid shape_function).
+!> The kernels are written once, in grid_transfer_kernels.inc, and instantiated for 2-D and 3-D, for
+!> each shape function (multilinear, quadratic B-spline) and for each velocity transfer (FLIP/PIC, APIC)
+!> with the dimension and the stencil as compile-time constants, so that the loops over axes and stencil
+!> nodes unroll. The public routines pick the instance from grid%dim, grid%shape (the scene's &grid
+!> shape_function) and whether the particles carry APIC's affine matrix C_p (particles%n_affine > 0,
+!> `&run transfer = 'apic'`; docs/theory.md, "APIC").
 module grid_transfer
    use kinds, only: rp
    use background_grid, only: grid_t, row_mass
@@ -12,21 +14,31 @@ module grid_transfer
    implicit none
    private
 
-   public :: particles_to_grid, update_velocity_and_remap, grid_to_particles, volume_to_grid, gradient_at_particles
+   public :: particles_to_grid, update_velocity_and_remap, grid_to_particles, volume_to_grid, gradient_at_particles, &
+             node_offsets
 
-   !> The kernel instances: dimension and shape function.
+   !> The kernel instances: shape function and dimension; APIC's are these + apic.
    integer, parameter :: kernels_linear_2d = 1, kernels_linear_3d = 2, kernels_bspline2_2d = 3, kernels_bspline2_3d = 4
+   integer, parameter :: apic = 4
 
 contains
 
-   !> The kernel instance of a grid.
+   !> The kernel instance of a grid (1 .. 4).
    pure integer function instance(grid)
       type(grid_t), intent(in) :: grid
       instance = merge(kernels_linear_2d, kernels_linear_3d, grid%dim == 2)
       if (grid%shape == shape_bspline2) instance = instance + 2
    end function instance
 
-   !> Step 1: m_i = sum N m_p, P_i = sum N m_p v_p,
+   !> The transfer kernels' instance of a grid and its particles: APIC's when they carry C_p (1 .. 8).
+   pure integer function transfer_instance(grid, particles)
+      type(grid_t), intent(in) :: grid
+      type(particle_set_t), intent(in) :: particles
+      transfer_instance = instance(grid)
+      if (particles%n_affine > 0) transfer_instance = transfer_instance + apic
+   end function transfer_instance
+
+   !> Step 1: m_i = sum N m_p, P_i = sum N m_p v_p (APIC: + sum N m_p C_p (x_i - x_p)),
    !> f_i = -sum m_p sbar_p . grad N_i + sum N m_p g   ([Y17] eq. 3; sbar is the filtered stress).
    !> With `field` (contact, src/solver/body_contact.f90): also each body field's mass, momentum, force and
    !> mass gradient sum m_p grad N_i in its rows of grid%accumulated from `field_row` on (field(p) = 0: the
@@ -38,24 +50,34 @@ contains
       integer, intent(in), optional :: field(:), field_row
       grid%accumulated = 0.0_rp
       if (present(field)) then
-         select case (instance(grid))
+         select case (transfer_instance(grid, particles))
          case (kernels_linear_2d); call particles_to_grid_fields_2d(grid, particles, gravity, field, field_row)
          case (kernels_linear_3d); call particles_to_grid_fields_3d(grid, particles, gravity, field, field_row)
          case (kernels_bspline2_2d); call particles_to_grid_fields_b2_2d(grid, particles, gravity, field, field_row)
-         case default; call particles_to_grid_fields_b2_3d(grid, particles, gravity, field, field_row)
+         case (kernels_bspline2_3d); call particles_to_grid_fields_b2_3d(grid, particles, gravity, field, field_row)
+         case (apic + kernels_linear_2d); call particles_to_grid_fields_apic_2d(grid, particles, gravity, field, field_row)
+         case (apic + kernels_linear_3d); call particles_to_grid_fields_apic_3d(grid, particles, gravity, field, field_row)
+         case (apic + kernels_bspline2_2d)
+            call particles_to_grid_fields_apic_b2_2d(grid, particles, gravity, field, field_row)
+         case default; call particles_to_grid_fields_apic_b2_3d(grid, particles, gravity, field, field_row)
          end select
       else
-         select case (instance(grid))
+         select case (transfer_instance(grid, particles))
          case (kernels_linear_2d); call particles_to_grid_2d(grid, particles, gravity)
          case (kernels_linear_3d); call particles_to_grid_3d(grid, particles, gravity)
          case (kernels_bspline2_2d); call particles_to_grid_b2_2d(grid, particles, gravity)
-         case default; call particles_to_grid_b2_3d(grid, particles, gravity)
+         case (kernels_bspline2_3d); call particles_to_grid_b2_3d(grid, particles, gravity)
+         case (apic + kernels_linear_2d); call particles_to_grid_apic_2d(grid, particles, gravity)
+         case (apic + kernels_linear_3d); call particles_to_grid_apic_3d(grid, particles, gravity)
+         case (apic + kernels_bspline2_2d); call particles_to_grid_apic_b2_2d(grid, particles, gravity)
+         case default; call particles_to_grid_apic_b2_3d(grid, particles, gravity)
          end select
       end if
    end subroutine particles_to_grid
 
    !> MUSL, first half of step 7 fused with the re-map: v_p := alpha (v_p + sum N dv_i) + (1 - alpha) sum N
    !> v_i^{n+1}, then momentum(:, i) = sum N m_p v_p with the updated velocities (both at x^n).
+   !> APIC: v_p := sum N v_i^{n+1}, C_p := B_p D_p^-1 from v_i^{n+1}, and the momentum as in step 1.
    !> With `field`: each particle's nodal velocities come from its field's rows of `velocity` and
    !> `increment` (dim (fields + 1), node); momentum rows 1:dim get the total, rows f dim + 1.. field f's.
    subroutine update_velocity_and_remap(grid, particles, flip_fraction, momentum, field, velocity, increment)
@@ -67,22 +89,34 @@ contains
       real(rp), intent(in), optional :: velocity(:, :), increment(:, :)
       momentum = 0.0_rp
       if (present(field)) then
-         select case (instance(grid))
+         select case (transfer_instance(grid, particles))
          case (kernels_linear_2d)
             call momentum_to_grid_fields_2d(grid, particles, flip_fraction, momentum, field, velocity, increment)
          case (kernels_linear_3d)
             call momentum_to_grid_fields_3d(grid, particles, flip_fraction, momentum, field, velocity, increment)
          case (kernels_bspline2_2d)
             call momentum_to_grid_fields_b2_2d(grid, particles, flip_fraction, momentum, field, velocity, increment)
-         case default
+         case (kernels_bspline2_3d)
             call momentum_to_grid_fields_b2_3d(grid, particles, flip_fraction, momentum, field, velocity, increment)
+         case (apic + kernels_linear_2d)
+            call momentum_to_grid_fields_apic_2d(grid, particles, momentum, field, velocity, increment)
+         case (apic + kernels_linear_3d)
+            call momentum_to_grid_fields_apic_3d(grid, particles, momentum, field, velocity, increment)
+         case (apic + kernels_bspline2_2d)
+            call momentum_to_grid_fields_apic_b2_2d(grid, particles, momentum, field, velocity, increment)
+         case default
+            call momentum_to_grid_fields_apic_b2_3d(grid, particles, momentum, field, velocity, increment)
          end select
       else
-         select case (instance(grid))
+         select case (transfer_instance(grid, particles))
          case (kernels_linear_2d); call momentum_to_grid_2d(grid, particles, flip_fraction, momentum)
          case (kernels_linear_3d); call momentum_to_grid_3d(grid, particles, flip_fraction, momentum)
          case (kernels_bspline2_2d); call momentum_to_grid_b2_2d(grid, particles, flip_fraction, momentum)
-         case default; call momentum_to_grid_b2_3d(grid, particles, flip_fraction, momentum)
+         case (kernels_bspline2_3d); call momentum_to_grid_b2_3d(grid, particles, flip_fraction, momentum)
+         case (apic + kernels_linear_2d); call momentum_to_grid_apic_2d(grid, particles, momentum)
+         case (apic + kernels_linear_3d); call momentum_to_grid_apic_3d(grid, particles, momentum)
+         case (apic + kernels_bspline2_2d); call momentum_to_grid_apic_b2_2d(grid, particles, momentum)
+         case default; call momentum_to_grid_apic_b2_3d(grid, particles, momentum)
          end select
       end if
    end subroutine update_velocity_and_remap
@@ -90,6 +124,7 @@ contains
    !> Steps 3 and 7 at x^n. With v_i^{n+theta} = v_i^{n+1} - (1 - theta) dv_i:
    !>   L_p = sum v_i^{n+theta} (x) grad N_i  -> strain_rate = sym(L), spin = skew(L)   (if compute_strain)
    !>   v_p := alpha (v_p + sum N dv_i) + (1 - alpha) sum N v_i^{n+1}                  (if update_velocity)
+   !>          APIC: v_p := sum N v_i^{n+1}, C_p := B_p D_p^-1 from v_i^{n+1}
    !>   x_p := x_p + dt sum N v_i^{n+theta}                                             (if update_position)
    !> `strain_velocity`, when present, replaces v^{n+theta} in L (MUSL: the re-mapped velocities).
    !> `compute_spin` (default: as compute_strain) = .false. leaves the spin alone: only solids use it.
@@ -115,7 +150,7 @@ contains
       lo = 0.0_rp
       hi = 0.0_rp
       if (present(field)) then
-         select case (instance(grid))
+         select case (transfer_instance(grid, particles))
          case (kernels_linear_2d)
             call grid_to_particles_fields_2d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
                                              spin, update_position, lo(1:2), hi(1:2), field, velocity, increment, &
@@ -127,13 +162,28 @@ contains
             call grid_to_particles_fields_b2_2d(grid, particles, dt, flip_fraction, theta, update_velocity, &
                                                 compute_strain, spin, update_position, lo(1:2), hi(1:2), field, &
                                                 velocity, increment, strain_velocity)
-         case default
+         case (kernels_bspline2_3d)
             call grid_to_particles_fields_b2_3d(grid, particles, dt, flip_fraction, theta, update_velocity, &
                                                 compute_strain, spin, update_position, lo, hi, field, velocity, &
                                                 increment, strain_velocity)
+         case (apic + kernels_linear_2d)
+            call grid_to_particles_fields_apic_2d(grid, particles, dt, theta, update_velocity, compute_strain, spin, &
+                                                  update_position, lo(1:2), hi(1:2), field, velocity, increment, &
+                                                  strain_velocity)
+         case (apic + kernels_linear_3d)
+            call grid_to_particles_fields_apic_3d(grid, particles, dt, theta, update_velocity, compute_strain, spin, &
+                                                  update_position, lo, hi, field, velocity, increment, strain_velocity)
+         case (apic + kernels_bspline2_2d)
+            call grid_to_particles_fields_apic_b2_2d(grid, particles, dt, theta, update_velocity, compute_strain, &
+                                                     spin, update_position, lo(1:2), hi(1:2), field, velocity, &
+                                                     increment, strain_velocity)
+         case default
+            call grid_to_particles_fields_apic_b2_3d(grid, particles, dt, theta, update_velocity, compute_strain, &
+                                                     spin, update_position, lo, hi, field, velocity, increment, &
+                                                     strain_velocity)
          end select
       else
-         select case (instance(grid))
+         select case (transfer_instance(grid, particles))
          case (kernels_linear_2d)
             call grid_to_particles_2d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
                                       spin, update_position, lo(1:2), hi(1:2), strain_velocity)
@@ -143,9 +193,21 @@ contains
          case (kernels_bspline2_2d)
             call grid_to_particles_b2_2d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
                                          spin, update_position, lo(1:2), hi(1:2), strain_velocity)
-         case default
+         case (kernels_bspline2_3d)
             call grid_to_particles_b2_3d(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
                                          spin, update_position, lo, hi, strain_velocity)
+         case (apic + kernels_linear_2d)
+            call grid_to_particles_apic_2d(grid, particles, dt, theta, update_velocity, compute_strain, spin, &
+                                           update_position, lo(1:2), hi(1:2), strain_velocity)
+         case (apic + kernels_linear_3d)
+            call grid_to_particles_apic_3d(grid, particles, dt, theta, update_velocity, compute_strain, spin, &
+                                           update_position, lo, hi, strain_velocity)
+         case (apic + kernels_bspline2_2d)
+            call grid_to_particles_apic_b2_2d(grid, particles, dt, theta, update_velocity, compute_strain, spin, &
+                                              update_position, lo(1:2), hi(1:2), strain_velocity)
+         case default
+            call grid_to_particles_apic_b2_3d(grid, particles, dt, theta, update_velocity, compute_strain, spin, &
+                                              update_position, lo, hi, strain_velocity)
          end select
       end if
       if (present(extent)) then
@@ -153,6 +215,19 @@ contains
          extent(:, 2) = hi
       end if
    end subroutine grid_to_particles
+
+   !> d(:, a) = x_a - x_p for the stencil nodes a of a particle at fractional position xi in a cell of
+   !> edge h, multilinear functions (APIC's offsets; exposed for the tests of D_p).
+   pure subroutine node_offsets(dim, xi, h, d)
+      integer, intent(in) :: dim
+      real(rp), intent(in) :: xi(:), h
+      real(rp), intent(out) :: d(:, :)
+      if (dim == 2) then
+         call node_offsets_2d(xi, h, d)
+      else
+         call node_offsets_3d(xi, h, d)
+      end if
+   end subroutine node_offsets
 
    !> o_i += sum_p N_ip m_p / rho_p over all particles (src/stabilization/volume_correction.f90).
    subroutine volume_to_grid(grid, particles, occupancy)
@@ -184,7 +259,13 @@ contains
       end select
    end subroutine gradient_at_particles
 
-! Single-field kernels: nodal velocities from the grid
+! APIC's C_p = B_p D_p^-1 = sum_a v_a (x) D_p^-1 (x_a - x_p) N_a (Jiang et al. 2015), per instance the term
+! AFFINE_GRADIENT(j, a) = [D_p^-1 (x_a - x_p) N_a]_j: for multilinear functions it is grad N_a exactly, also
+! on the grid lines where D_p is singular; for quadratic B-splines D_p = h^2/4 I at every position, so it
+! is (4 / h^2) (x_a - x_p) N_a, with d(:, a) = x_a - x_p from OFFSETS (docs/theory.md, "APIC").
+
+! FLIP/PIC, single field: nodal velocities from the grid (and the volume and gradient kernels)
+#define BLEND flip_fraction,
 #define VEL(i, node) grid%velocity(i, node)
 #define INC(i, node) grid%velocity_increment(i, node)
 
@@ -193,6 +274,7 @@ contains
 #define SHAPE shape_2d
 #define BASE base_linear
 #define LOCATE locate_2d
+#define OFFSETS node_offsets_2d
 #define P2G particles_to_grid_2d
 #define M2G momentum_to_grid_2d
 #define G2P grid_to_particles_2d
@@ -200,22 +282,14 @@ contains
 #define GRAD2P gradient_at_particles_2d
 #include "../grid/multilinear_shape.inc"
 #include "grid_transfer_kernels.inc"
-#undef KERNEL_DIM
-#undef WIDTH
-#undef SHAPE
-#undef BASE
-#undef LOCATE
-#undef P2G
-#undef M2G
-#undef G2P
-#undef V2G
-#undef GRAD2P
+#include "grid_transfer_undef.inc"
 
 #define KERNEL_DIM 3
 #define WIDTH 2
 #define SHAPE shape_3d
 #define BASE base_linear
 #define LOCATE locate_3d
+#define OFFSETS node_offsets_3d
 #define P2G particles_to_grid_3d
 #define M2G momentum_to_grid_3d
 #define G2P grid_to_particles_3d
@@ -223,22 +297,14 @@ contains
 #define GRAD2P gradient_at_particles_3d
 #include "../grid/multilinear_shape.inc"
 #include "grid_transfer_kernels.inc"
-#undef KERNEL_DIM
-#undef WIDTH
-#undef SHAPE
-#undef BASE
-#undef LOCATE
-#undef P2G
-#undef M2G
-#undef G2P
-#undef V2G
-#undef GRAD2P
+#include "grid_transfer_undef.inc"
 
 #define KERNEL_DIM 2
 #define WIDTH 3
 #define SHAPE bspline2_2d
 #define BASE base_bspline2
 #define LOCATE locate_b2_2d
+#define OFFSETS node_offsets_b2_2d
 #define P2G particles_to_grid_b2_2d
 #define M2G momentum_to_grid_b2_2d
 #define G2P grid_to_particles_b2_2d
@@ -246,22 +312,14 @@ contains
 #define GRAD2P gradient_at_particles_b2_2d
 #include "../grid/bspline2_shape.inc"
 #include "grid_transfer_kernels.inc"
-#undef KERNEL_DIM
-#undef WIDTH
-#undef SHAPE
-#undef BASE
-#undef LOCATE
-#undef P2G
-#undef M2G
-#undef G2P
-#undef V2G
-#undef GRAD2P
+#include "grid_transfer_undef.inc"
 
 #define KERNEL_DIM 3
 #define WIDTH 3
 #define SHAPE bspline2_3d
 #define BASE base_bspline2
 #define LOCATE locate_b2_3d
+#define OFFSETS node_offsets_b2_3d
 #define P2G particles_to_grid_b2_3d
 #define M2G momentum_to_grid_b2_3d
 #define G2P grid_to_particles_b2_3d
@@ -269,21 +327,12 @@ contains
 #define GRAD2P gradient_at_particles_b2_3d
 #include "../grid/bspline2_shape.inc"
 #include "grid_transfer_kernels.inc"
-#undef KERNEL_DIM
-#undef WIDTH
-#undef SHAPE
-#undef BASE
-#undef LOCATE
-#undef P2G
-#undef M2G
-#undef G2P
-#undef V2G
-#undef GRAD2P
+#include "grid_transfer_undef.inc"
+
+! FLIP/PIC, the multi-field kernels of contact: each particle's own field, rows o + 1.. (o = field(p) dim)
+#define FIELDS
 #undef VEL
 #undef INC
-
-! Multi-field kernels of contact: each particle's own field, rows o + 1.. (o = field(p) dim)
-#define FIELDS
 #define VEL(i, node) velocity(o + (i), node)
 #define INC(i, node) increment(o + (i), node)
 
@@ -292,70 +341,167 @@ contains
 #define SHAPE shape_2d
 #define BASE base_linear
 #define LOCATE locate_2d
+#define OFFSETS node_offsets_2d
 #define P2G particles_to_grid_fields_2d
 #define M2G momentum_to_grid_fields_2d
 #define G2P grid_to_particles_fields_2d
 #include "grid_transfer_kernels.inc"
-#undef KERNEL_DIM
-#undef WIDTH
-#undef SHAPE
-#undef BASE
-#undef LOCATE
-#undef P2G
-#undef M2G
-#undef G2P
+#include "grid_transfer_undef.inc"
 
 #define KERNEL_DIM 3
 #define WIDTH 2
 #define SHAPE shape_3d
 #define BASE base_linear
 #define LOCATE locate_3d
+#define OFFSETS node_offsets_3d
 #define P2G particles_to_grid_fields_3d
 #define M2G momentum_to_grid_fields_3d
 #define G2P grid_to_particles_fields_3d
 #include "grid_transfer_kernels.inc"
-#undef KERNEL_DIM
-#undef WIDTH
-#undef SHAPE
-#undef BASE
-#undef LOCATE
-#undef P2G
-#undef M2G
-#undef G2P
+#include "grid_transfer_undef.inc"
 
 #define KERNEL_DIM 2
 #define WIDTH 3
 #define SHAPE bspline2_2d
 #define BASE base_bspline2
 #define LOCATE locate_b2_2d
+#define OFFSETS node_offsets_b2_2d
 #define P2G particles_to_grid_fields_b2_2d
 #define M2G momentum_to_grid_fields_b2_2d
 #define G2P grid_to_particles_fields_b2_2d
 #include "grid_transfer_kernels.inc"
-#undef KERNEL_DIM
-#undef WIDTH
-#undef SHAPE
-#undef BASE
-#undef LOCATE
-#undef P2G
-#undef M2G
-#undef G2P
+#include "grid_transfer_undef.inc"
 
 #define KERNEL_DIM 3
 #define WIDTH 3
 #define SHAPE bspline2_3d
 #define BASE base_bspline2
 #define LOCATE locate_b2_3d
+#define OFFSETS node_offsets_b2_3d
 #define P2G particles_to_grid_fields_b2_3d
 #define M2G momentum_to_grid_fields_b2_3d
 #define G2P grid_to_particles_fields_b2_3d
 #include "grid_transfer_kernels.inc"
-#undef KERNEL_DIM
-#undef WIDTH
-#undef SHAPE
-#undef BASE
-#undef LOCATE
-#undef P2G
-#undef M2G
-#undef G2P
+#include "grid_transfer_undef.inc"
+
+! APIC (AFFINE), single field: the same kernels with the affine terms; the FLIP/PIC ones above are untouched
+#define AFFINE
+#undef BLEND
+#define BLEND
+#undef FIELDS
+#undef VEL
+#undef INC
+#define VEL(i, node) grid%velocity(i, node)
+#define INC(i, node) grid%velocity_increment(i, node)
+
+#define KERNEL_DIM 2
+#define WIDTH 2
+#define SHAPE shape_2d
+#define BASE base_linear
+#define LOCATE locate_2d
+#define OFFSETS node_offsets_2d
+#define P2G particles_to_grid_apic_2d
+#define M2G momentum_to_grid_apic_2d
+#define G2P grid_to_particles_apic_2d
+#define AFFINE_GRADIENT(j, a) g(j, a)
+#include "grid_transfer_kernels.inc"
+#include "grid_transfer_undef.inc"
+
+#define KERNEL_DIM 3
+#define WIDTH 2
+#define SHAPE shape_3d
+#define BASE base_linear
+#define LOCATE locate_3d
+#define OFFSETS node_offsets_3d
+#define P2G particles_to_grid_apic_3d
+#define M2G momentum_to_grid_apic_3d
+#define G2P grid_to_particles_apic_3d
+#define AFFINE_GRADIENT(j, a) g(j, a)
+#include "grid_transfer_kernels.inc"
+#include "grid_transfer_undef.inc"
+
+#define KERNEL_DIM 2
+#define WIDTH 3
+#define SHAPE bspline2_2d
+#define BASE base_bspline2
+#define LOCATE locate_b2_2d
+#define OFFSETS node_offsets_b2_2d
+#define P2G particles_to_grid_apic_b2_2d
+#define M2G momentum_to_grid_apic_b2_2d
+#define G2P grid_to_particles_apic_b2_2d
+#define AFFINE_GRADIENT(j, a) (4.0_rp * grid%inv_h**2 * n(a) * d(j, a))
+#include "grid_transfer_kernels.inc"
+#include "grid_transfer_undef.inc"
+
+#define KERNEL_DIM 3
+#define WIDTH 3
+#define SHAPE bspline2_3d
+#define BASE base_bspline2
+#define LOCATE locate_b2_3d
+#define OFFSETS node_offsets_b2_3d
+#define P2G particles_to_grid_apic_b2_3d
+#define M2G momentum_to_grid_apic_b2_3d
+#define G2P grid_to_particles_apic_b2_3d
+#define AFFINE_GRADIENT(j, a) (4.0_rp * grid%inv_h**2 * n(a) * d(j, a))
+#include "grid_transfer_kernels.inc"
+#include "grid_transfer_undef.inc"
+
+! APIC, the multi-field kernels of contact
+#define FIELDS
+#undef VEL
+#undef INC
+#define VEL(i, node) velocity(o + (i), node)
+#define INC(i, node) increment(o + (i), node)
+
+#define KERNEL_DIM 2
+#define WIDTH 2
+#define SHAPE shape_2d
+#define BASE base_linear
+#define LOCATE locate_2d
+#define OFFSETS node_offsets_2d
+#define P2G particles_to_grid_fields_apic_2d
+#define M2G momentum_to_grid_fields_apic_2d
+#define G2P grid_to_particles_fields_apic_2d
+#define AFFINE_GRADIENT(j, a) g(j, a)
+#include "grid_transfer_kernels.inc"
+#include "grid_transfer_undef.inc"
+
+#define KERNEL_DIM 3
+#define WIDTH 2
+#define SHAPE shape_3d
+#define BASE base_linear
+#define LOCATE locate_3d
+#define OFFSETS node_offsets_3d
+#define P2G particles_to_grid_fields_apic_3d
+#define M2G momentum_to_grid_fields_apic_3d
+#define G2P grid_to_particles_fields_apic_3d
+#define AFFINE_GRADIENT(j, a) g(j, a)
+#include "grid_transfer_kernels.inc"
+#include "grid_transfer_undef.inc"
+
+#define KERNEL_DIM 2
+#define WIDTH 3
+#define SHAPE bspline2_2d
+#define BASE base_bspline2
+#define LOCATE locate_b2_2d
+#define OFFSETS node_offsets_b2_2d
+#define P2G particles_to_grid_fields_apic_b2_2d
+#define M2G momentum_to_grid_fields_apic_b2_2d
+#define G2P grid_to_particles_fields_apic_b2_2d
+#define AFFINE_GRADIENT(j, a) (4.0_rp * grid%inv_h**2 * n(a) * d(j, a))
+#include "grid_transfer_kernels.inc"
+#include "grid_transfer_undef.inc"
+
+#define KERNEL_DIM 3
+#define WIDTH 3
+#define SHAPE bspline2_3d
+#define BASE base_bspline2
+#define LOCATE locate_b2_3d
+#define OFFSETS node_offsets_b2_3d
+#define P2G particles_to_grid_fields_apic_b2_3d
+#define M2G momentum_to_grid_fields_apic_b2_3d
+#define G2P grid_to_particles_fields_apic_b2_3d
+#define AFFINE_GRADIENT(j, a) (4.0_rp * grid%inv_h**2 * n(a) * d(j, a))
+#include "grid_transfer_kernels.inc"
+#include "grid_transfer_undef.inc"
 end module grid_transfer

@@ -24,6 +24,7 @@ module test_checkpoint
    private
 
    public :: test_restart_on_same_ranks_is_bitwise, test_restart_with_foal1_is_bitwise, test_restart_on_other_rank_count, &
+             test_restart_with_apic_is_bitwise, test_apic_restart_on_other_rank_count, &
              test_restart_of_moved_region_is_bitwise, test_moved_region_on_other_rank_count, &
              test_checkpoint_of_other_scene_is_refused, test_other_format_version_is_refused, &
              test_only_newest_checkpoints_are_kept
@@ -99,6 +100,26 @@ contains
       call check_bitwise_restart(comm, scene)
    end subroutine test_restart_with_foal1_is_bitwise
 
+   !> The same with APIC: the affine matrices B_p are part of the state (checkpoint /particles/affine).
+   subroutine test_restart_with_apic_is_bitwise(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(scene_t) :: scene
+      scene = column_scene('apic')
+      scene%run%transfer = 'apic'
+      scene%run%fixed_dt = 1.0e-4_rp     ! APIC is not stable at this column's CFL step (docs/theory.md)
+      call check_bitwise_restart(comm, scene)
+   end subroutine test_restart_with_apic_is_bitwise
+
+   !> APIC written on all ranks, continued on one rank fewer: the B_p travel with their particles.
+   subroutine test_apic_restart_on_other_rank_count(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(scene_t) :: scene
+      scene = column_scene('apic_other_ranks')
+      scene%run%transfer = 'apic'
+      scene%run%fixed_dt = 1.0e-4_rp
+      call check_restart_on_fewer_ranks(comm, scene)
+   end subroutine test_apic_restart_on_other_rank_count
+
    !> The checkpoint of a moved active region (cuts that do not span the grid) continues bitwise.
    subroutine test_restart_of_moved_region_is_bitwise(comm)
       type(MPI_Comm), intent(in) :: comm
@@ -148,6 +169,10 @@ contains
          call assertEqual(uninterrupted%particles%v(:, 1:n), restarted%particles%v(:, 1:n), 0.0_rp, 'velocities')
          call assertEqual(uninterrupted%particles%sbar(:, 1:n), restarted%particles%sbar(:, 1:n), 0.0_rp, 'stresses')
          call assertTrue(all(uninterrupted%particles%id(1:n) == restarted%particles%id(1:n)), 'same order')
+         call assertEqual(uninterrupted%particles%n_affine, restarted%particles%n_affine, 'affine matrices carried')
+         if (uninterrupted%particles%n_affine > 0) &
+            call assertEqual(uninterrupted%particles%affine(:, 1:n), restarted%particles%affine(:, 1:n), 0.0_rp, &
+                             'affine matrices (APIC)')
       end if
       call uninterrupted%free()
       call restarted%free()
