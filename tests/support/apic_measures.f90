@@ -4,7 +4,7 @@ module apic_measures
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_SUM
    use background_grid, only: grid_t
    use particle_set, only: particle_set_t
-   use shape_functions, only: shape_values_and_gradients
+   use shape_functions, only: shape_values_and_gradients, shape_bspline2
    use grid_transfer, only: node_offsets
    implicit none
    private
@@ -39,13 +39,21 @@ contains
       call MPI_Allreduce(MPI_IN_PLACE, l, 3, MPI_DOUBLE_PRECISION, MPI_SUM, comm)
    end function particle_angular_momentum
 
-   !> D_p = sum_a N_a (x_a - x_p)(x_a - x_p)^T of a particle at x (its cell located as the kernels do).
+   !> D_p = sum_a N_a (x_a - x_p)(x_a - x_p)^T of a particle at x (its cell located as the kernels do); with
+   !> quadratic B-splines h^2/4 I at any x ([J15] sec. 5.4).
    function particle_d(grid, x) result(dp)
       type(grid_t), intent(in) :: grid
       real(rp), intent(in) :: x(:)
       real(rp) :: dp(grid%dim, grid%dim), xi(grid%dim), n(2**grid%dim), g(grid%dim, 2**grid%dim)
       real(rp) :: d(grid%dim, 2**grid%dim)
       integer :: k, a
+      if (grid%shape == shape_bspline2) then
+         dp = 0.0_rp
+         do k = 1, grid%dim
+            dp(k, k) = 0.25_rp * grid%h**2
+         end do
+         return
+      end if
       do k = 1, grid%dim
          xi(k) = (x(k) - grid%origin(k)) * grid%inv_h
          xi(k) = xi(k) - real(min(floor(xi(k)), grid%global_cells(k) - 1), rp)
