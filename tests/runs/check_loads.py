@@ -92,11 +92,11 @@ def shaped(template, shape, workdir):
     return path
 
 
-def run(checks, flotsam, template, name, ranks, *arguments, **run_values):
+def run(checks, flotsam, template, name, ranks, *arguments, timeout=600, **run_values):
     """Run scene `template` into the folder `name` of the working directory; True if it finished."""
     flotsam.remove(name)
     scene = flotsam.scene(template, name + ".nml", name, **run_values)
-    result = flotsam.run(scene, ranks, *arguments)
+    result = flotsam.run(scene, ranks, *arguments, timeout=timeout)
     return checks.check(result.returncode == 0, f"{name}: run on {ranks} ranks", result.stderr[-2000:])
 
 
@@ -141,7 +141,8 @@ def check_hydrostatic_rotated(checks, flotsam, scenes):
     settled = 0.1       # the start-up oscillation is left out (scene comment)
     for angle in ["30.0", "45.0"]:
         name = f"hydrostatic_rotated_{angle.split('.')[0]}"
-        if not run(checks, flotsam, template, name, 2, "--set", f"&grid rotation = {angle} /"):
+        # about 7 minutes per angle in Debug on 2 idle cores: room for a shared machine
+        if not run(checks, flotsam, template, name, 2, "--set", f"&grid rotation = {angle} /", timeout=2400):
             continue
         loads = read(flotsam.path(name), "loads")
         window = loads[loads["time"] > settled * (1 + 1e-9)]

@@ -8,7 +8,11 @@
   * a case stopped by SIGTERM to its ranks (what a batch system sends), and one whose study got
     SIGTERM (the study passes SIGUSR1 on to the case), are not done: the study exits with 5, and the
     next call continues them from their checkpoints; their cost adds up both invocations;
-  * --report tabulates the cases that are done without running anything; a bad study file is refused.
+  * --report tabulates the cases that are done without running anything; a bad study file is refused;
+  * the measures: [load] on the tank (its side wall's force, exact at rest on the aligned grid:
+    rho g H^2 / 2 = 51 200 N/m) and [surge] on a coarse dam break of Koshizuka & Oka (inputs/dam_break_ko.nml,
+    10 cells per L): the front at the measured times, each within 10 % of the measurement while the
+    front has not yet run ahead (T < 1.6), and growing with T; a [surge] without its width is refused.
 
 usage: check_study.py <flotsam> <mpiexec> <tests/runs/scenes> <scripts folder>"""
 
@@ -55,10 +59,43 @@ def read_results(path):
         return list(csv.DictReader(f))
 
 
-def write_study(path, scene, output, parameters):
+def write_study(path, scene, output, parameters, measures="[hydrostatic]\ndensity = 1000.0\ngravity = 10.0\n"
+                "[load]\ncolumn = x_max_fx\nexpected = 51200.0\n"):
     with open(path, "w") as f:
-        f.write(f"[study]\nscene = {scene}\nranks = 2\noutput = {output}\n[parameters]\n{parameters}\n"
-                "[hydrostatic]\ndensity = 1000.0\ngravity = 10.0\n")
+        f.write(f"[study]\nscene = {scene}\nranks = 2\noutput = {output}\n[parameters]\n{parameters}\n{measures}")
+
+
+def check_surge(checks, scripts, inputs, work, flotsam_path, mpiexec):
+    """[surge]: the dam break's front against Koshizuka & Oka at the measured times."""
+    study = os.path.join(work, "surge.study")
+    out = os.path.join(work, "surge")
+    write_study(study, os.path.join(inputs, "dam_break_ko.nml"), out,
+                "grid cell_size = [0.0146]\nrun output_interval = [0.005]",
+                "[surge]\nwidth = 0.146\ngravity = 9.81\n")
+    result = subprocess.run([sys.executable, os.path.join(scripts, "study"), study, "--flotsam", flotsam_path,
+                             "--mpiexec", mpiexec], capture_output=True, text=True)
+    results = os.path.join(out, "results.csv")
+    if not checks.check(result.returncode == 0 and os.path.exists(results), "[surge]: the dam break study runs",
+                        result.stdout[-800:] + result.stderr[-800:]):
+        return
+    row = read_results(results)[0]
+    measured = {0.381: 1.111, 0.769: 1.252, 1.153: 1.505, 1.537: 1.892, 1.935: 2.241, 2.323: 2.615,
+                2.719: 3.003, 3.096: 3.624}
+    z = [float(row[f"surge_Z_{t:.3f}"]) for t in measured]
+    early = [(zi, measured[t]) for zi, t in zip(z, measured) if t < 1.6]
+    checks.check(all(abs(zi / ref - 1) < 0.1 for zi, ref in early), "[surge]: the front within 10 % of Koshizuka & "
+                 "Oka while T < 1.6", str(early))
+    checks.check(all(b > a for a, b in zip(z, z[1:])), "[surge]: the front advances with T", str(z))
+    deviation = sum(abs(zi / ref - 1) for zi, ref in zip(z, measured.values())) / len(z)
+    checks.check(abs(float(row["surge_front_error_percent"]) - 100 * deviation) < 1e-9,
+                 "[surge]: surge_front_error_percent is the mean |Z / Z_measured - 1|", row["surge_front_error_percent"])
+    with open(os.path.join(work, "no_width.study"), "w") as f:
+        f.write(f"[study]\nscene = {os.path.join(inputs, 'dam_break_ko.nml')}\n[parameters]\ngrid rotation = [0.0]\n"
+                "[surge]\ngravity = 9.81\n")
+    bad = subprocess.run([sys.executable, os.path.join(scripts, "study"), os.path.join(work, "no_width.study"),
+                          "--dry-run"], capture_output=True, text=True)
+    checks.check(bad.returncode != 0 and "[surge] width is required" in bad.stderr, "[surge] without width is refused",
+                 bad.stderr)
 
 
 def main():
@@ -113,7 +150,11 @@ def main():
         # RMS h / (sqrt(12) H) = 0.4 / (sqrt(12) 3.2) = 0.036
         checks.check(len(aligned) == 1 and abs(float(aligned[0]["pressure_rms_error_relative"]) - 0.036) < 0.003,
                      "aligned tank, C0: pressure error = the cell-averaging error", str(aligned))
+        checks.check(len(aligned) == 1 and abs(float(aligned[0]["load_error_percent"])) < 1e-6,
+                     "[load]: the aligned tank's side wall carries rho g H^2 / 2 (load_error_percent)",
+                     str(aligned and aligned[0]["load_error_percent"]))
     checks.check(os.path.exists(os.path.join(out, "pareto.png")), "pareto.png written")
+    check_surge(checks, scripts, inputs, work, flotsam_path, mpiexec)
 
     # --- the base scene changes: nothing stale is reused ------------------------------------------------
     with open(scene) as f:
