@@ -7,7 +7,9 @@ Runs the scenes of inputs/ (tank_filling.nml, hydrostatic_tank.nml, floating_blo
 variants (scheme, grid rotation, cells per length, particles per cell: set with scene_variant.py, the
 files are not copied by hand) with build/release/flotsam, into output/paper/<case>/; draws the
 figures into docs/figures/ and prints the measured numbers (also in output/paper/summary.json).
-A case whose diagnostics.csv already reaches the end time is not run again. With --check the
+A case whose diagnostics.csv already reaches the end time and that was run by the same flotsam
+executable (its SHA-256, kept in the case folder as flotsam.sha256) is not run again; a rebuilt flotsam
+runs every case afresh, so --check always judges the code that is built. With --check the
 claims that docs/validation.md states as reproduced are asserted (exit 1 if one fails).
 Without figure names, all four are made (about 15 minutes on 2 cores). `volume` makes the figures of
 docs/volume-conservation.md: the tank at 45 degrees and the floating block with FOAL1, NB and FOAL1
@@ -17,6 +19,7 @@ with the volume corrections side by side (about 30 minutes on 2 cores).
 import argparse
 import csv
 import glob
+import hashlib
 import json
 import os
 import subprocess
@@ -42,11 +45,25 @@ summary = {}
 failures = []
 
 
+def executable_hash():
+    """SHA-256 of the flotsam executable (computed once)."""
+    if "sha256" not in executable_hash.__dict__:
+        digest = hashlib.sha256()
+        with open(FLOTSAM, "rb") as f:
+            for block in iter(lambda: f.read(1 << 20), b""):
+                digest.update(block)
+        executable_hash.sha256 = digest.hexdigest()
+    return executable_hash.sha256
+
+
 def run_case(name, source, changes, ranks, end_time):
-    """Run a variant of `source` into output/paper/<name> unless it already finished; its folder."""
+    """Run a variant of `source` into output/paper/<name> unless this flotsam already finished it; its
+    folder."""
     folder = os.path.join(OUT, name)
     rows = diagnostics(folder)
-    if rows and abs(float(rows[-1]["time"]) - end_time) < 1e-9 * max(1.0, end_time):
+    stamp = os.path.join(folder, "flotsam.sha256")
+    same = os.path.exists(stamp) and open(stamp).read().strip() == executable_hash()
+    if same and rows and abs(float(rows[-1]["time"]) - end_time) < 1e-9 * max(1.0, end_time):
         return folder
     os.makedirs(OUT, exist_ok=True)
     changes.setdefault("run", {}).update({"output_dir": "'%s'" % folder, "overwrite": ".true.",
@@ -59,6 +76,9 @@ def run_case(name, source, changes, ranks, end_time):
     result = subprocess.run([launcher, "-np", str(ranks), FLOTSAM, scene], env=env, capture_output=True, text=True)
     seconds = time.time() - start
     rows = diagnostics(folder)
+    if os.path.isdir(folder):
+        with open(stamp, "w") as f:
+            f.write(executable_hash() + "\n")
     summary.setdefault("runs", {})[name] = {"exit": result.returncode, "wall_seconds": round(seconds, 1),
                                             "steps": int(rows[-1]["step"]) if rows else 0,
                                             "ranks": ranks}
