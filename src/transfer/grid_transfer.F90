@@ -266,6 +266,7 @@ contains
 
 ! FLIP/PIC, single field: nodal velocities from the grid (and the volume and gradient kernels)
 #define BLEND flip_fraction,
+#define NODE_MOMENTUM(i) mv(i)
 #define VEL(i, node) grid%velocity(i, node)
 #define INC(i, node) grid%velocity_increment(i, node)
 
@@ -388,6 +389,8 @@ contains
 #define AFFINE
 #undef BLEND
 #define BLEND
+#undef NODE_MOMENTUM
+#define NODE_MOMENTUM(i) pv(i)
 #undef FIELDS
 #undef VEL
 #undef INC
