@@ -18,6 +18,7 @@ with the volume corrections side by side (about 30 minutes on 2 cores).
 
 import argparse
 import csv
+import functools
 import glob
 import hashlib
 import json
@@ -45,15 +46,11 @@ summary = {}
 failures = []
 
 
+@functools.lru_cache(maxsize=None)
 def executable_hash():
     """SHA-256 of the flotsam executable (computed once)."""
-    if "sha256" not in executable_hash.__dict__:
-        digest = hashlib.sha256()
-        with open(FLOTSAM, "rb") as f:
-            for block in iter(lambda: f.read(1 << 20), b""):
-                digest.update(block)
-        executable_hash.sha256 = digest.hexdigest()
-    return executable_hash.sha256
+    with open(FLOTSAM, "rb") as f:
+        return hashlib.file_digest(f, "sha256").hexdigest()
 
 
 def run_case(name, source, changes, ranks, end_time):

@@ -270,12 +270,8 @@ contains
 #define VEL(i, node) grid%velocity(i, node)
 #define INC(i, node) grid%velocity_increment(i, node)
 
-#define KERNEL_DIM 2
-#define WIDTH 2
-#define SHAPE shape_2d
-#define BASE base_linear
-#define LOCATE locate_2d
-#define OFFSETS node_offsets_2d
+#define STENCIL 1
+#include "grid_transfer_stencil.inc"
 #define P2G particles_to_grid_2d
 #define M2G momentum_to_grid_2d
 #define G2P grid_to_particles_2d
@@ -285,12 +281,8 @@ contains
 #include "grid_transfer_kernels.inc"
 #include "grid_transfer_undef.inc"
 
-#define KERNEL_DIM 3
-#define WIDTH 2
-#define SHAPE shape_3d
-#define BASE base_linear
-#define LOCATE locate_3d
-#define OFFSETS node_offsets_3d
+#define STENCIL 2
+#include "grid_transfer_stencil.inc"
 #define P2G particles_to_grid_3d
 #define M2G momentum_to_grid_3d
 #define G2P grid_to_particles_3d
@@ -300,12 +292,8 @@ contains
 #include "grid_transfer_kernels.inc"
 #include "grid_transfer_undef.inc"
 
-#define KERNEL_DIM 2
-#define WIDTH 3
-#define SHAPE bspline2_2d
-#define BASE base_bspline2
-#define LOCATE locate_b2_2d
-#define OFFSETS node_offsets_b2_2d
+#define STENCIL 3
+#include "grid_transfer_stencil.inc"
 #define P2G particles_to_grid_b2_2d
 #define M2G momentum_to_grid_b2_2d
 #define G2P grid_to_particles_b2_2d
@@ -315,12 +303,8 @@ contains
 #include "grid_transfer_kernels.inc"
 #include "grid_transfer_undef.inc"
 
-#define KERNEL_DIM 3
-#define WIDTH 3
-#define SHAPE bspline2_3d
-#define BASE base_bspline2
-#define LOCATE locate_b2_3d
-#define OFFSETS node_offsets_b2_3d
+#define STENCIL 4
+#include "grid_transfer_stencil.inc"
 #define P2G particles_to_grid_b2_3d
 #define M2G momentum_to_grid_b2_3d
 #define G2P grid_to_particles_b2_3d
@@ -337,48 +321,32 @@ contains
 #define VEL(i, node) velocity(o + (i), node)
 #define INC(i, node) increment(o + (i), node)
 
-#define KERNEL_DIM 2
-#define WIDTH 2
-#define SHAPE shape_2d
-#define BASE base_linear
-#define LOCATE locate_2d
-#define OFFSETS node_offsets_2d
+#define STENCIL 1
+#include "grid_transfer_stencil.inc"
 #define P2G particles_to_grid_fields_2d
 #define M2G momentum_to_grid_fields_2d
 #define G2P grid_to_particles_fields_2d
 #include "grid_transfer_kernels.inc"
 #include "grid_transfer_undef.inc"
 
-#define KERNEL_DIM 3
-#define WIDTH 2
-#define SHAPE shape_3d
-#define BASE base_linear
-#define LOCATE locate_3d
-#define OFFSETS node_offsets_3d
+#define STENCIL 2
+#include "grid_transfer_stencil.inc"
 #define P2G particles_to_grid_fields_3d
 #define M2G momentum_to_grid_fields_3d
 #define G2P grid_to_particles_fields_3d
 #include "grid_transfer_kernels.inc"
 #include "grid_transfer_undef.inc"
 
-#define KERNEL_DIM 2
-#define WIDTH 3
-#define SHAPE bspline2_2d
-#define BASE base_bspline2
-#define LOCATE locate_b2_2d
-#define OFFSETS node_offsets_b2_2d
+#define STENCIL 3
+#include "grid_transfer_stencil.inc"
 #define P2G particles_to_grid_fields_b2_2d
 #define M2G momentum_to_grid_fields_b2_2d
 #define G2P grid_to_particles_fields_b2_2d
 #include "grid_transfer_kernels.inc"
 #include "grid_transfer_undef.inc"
 
-#define KERNEL_DIM 3
-#define WIDTH 3
-#define SHAPE bspline2_3d
-#define BASE base_bspline2
-#define LOCATE locate_b2_3d
-#define OFFSETS node_offsets_b2_3d
+#define STENCIL 4
+#include "grid_transfer_stencil.inc"
 #define P2G particles_to_grid_fields_b2_3d
 #define M2G momentum_to_grid_fields_b2_3d
 #define G2P grid_to_particles_fields_b2_3d
@@ -397,55 +365,35 @@ contains
 #define VEL(i, node) grid%velocity(i, node)
 #define INC(i, node) grid%velocity_increment(i, node)
 
-#define KERNEL_DIM 2
-#define WIDTH 2
-#define SHAPE shape_2d
-#define BASE base_linear
-#define LOCATE locate_2d
-#define OFFSETS node_offsets_2d
+#define STENCIL 1
+#include "grid_transfer_stencil.inc"
 #define P2G particles_to_grid_apic_2d
 #define M2G momentum_to_grid_apic_2d
 #define G2P grid_to_particles_apic_2d
-#define AFFINE_GRADIENT(j, a) g(j, a)
 #include "grid_transfer_kernels.inc"
 #include "grid_transfer_undef.inc"
 
-#define KERNEL_DIM 3
-#define WIDTH 2
-#define SHAPE shape_3d
-#define BASE base_linear
-#define LOCATE locate_3d
-#define OFFSETS node_offsets_3d
+#define STENCIL 2
+#include "grid_transfer_stencil.inc"
 #define P2G particles_to_grid_apic_3d
 #define M2G momentum_to_grid_apic_3d
 #define G2P grid_to_particles_apic_3d
-#define AFFINE_GRADIENT(j, a) g(j, a)
 #include "grid_transfer_kernels.inc"
 #include "grid_transfer_undef.inc"
 
-#define KERNEL_DIM 2
-#define WIDTH 3
-#define SHAPE bspline2_2d
-#define BASE base_bspline2
-#define LOCATE locate_b2_2d
-#define OFFSETS node_offsets_b2_2d
+#define STENCIL 3
+#include "grid_transfer_stencil.inc"
 #define P2G particles_to_grid_apic_b2_2d
 #define M2G momentum_to_grid_apic_b2_2d
 #define G2P grid_to_particles_apic_b2_2d
-#define AFFINE_GRADIENT(j, a) (4.0_rp * grid%inv_h**2 * n(a) * d(j, a))
 #include "grid_transfer_kernels.inc"
 #include "grid_transfer_undef.inc"
 
-#define KERNEL_DIM 3
-#define WIDTH 3
-#define SHAPE bspline2_3d
-#define BASE base_bspline2
-#define LOCATE locate_b2_3d
-#define OFFSETS node_offsets_b2_3d
+#define STENCIL 4
+#include "grid_transfer_stencil.inc"
 #define P2G particles_to_grid_apic_b2_3d
 #define M2G momentum_to_grid_apic_b2_3d
 #define G2P grid_to_particles_apic_b2_3d
-#define AFFINE_GRADIENT(j, a) (4.0_rp * grid%inv_h**2 * n(a) * d(j, a))
 #include "grid_transfer_kernels.inc"
 #include "grid_transfer_undef.inc"
 
@@ -456,55 +404,35 @@ contains
 #define VEL(i, node) velocity(o + (i), node)
 #define INC(i, node) increment(o + (i), node)
 
-#define KERNEL_DIM 2
-#define WIDTH 2
-#define SHAPE shape_2d
-#define BASE base_linear
-#define LOCATE locate_2d
-#define OFFSETS node_offsets_2d
+#define STENCIL 1
+#include "grid_transfer_stencil.inc"
 #define P2G particles_to_grid_fields_apic_2d
 #define M2G momentum_to_grid_fields_apic_2d
 #define G2P grid_to_particles_fields_apic_2d
-#define AFFINE_GRADIENT(j, a) g(j, a)
 #include "grid_transfer_kernels.inc"
 #include "grid_transfer_undef.inc"
 
-#define KERNEL_DIM 3
-#define WIDTH 2
-#define SHAPE shape_3d
-#define BASE base_linear
-#define LOCATE locate_3d
-#define OFFSETS node_offsets_3d
+#define STENCIL 2
+#include "grid_transfer_stencil.inc"
 #define P2G particles_to_grid_fields_apic_3d
 #define M2G momentum_to_grid_fields_apic_3d
 #define G2P grid_to_particles_fields_apic_3d
-#define AFFINE_GRADIENT(j, a) g(j, a)
 #include "grid_transfer_kernels.inc"
 #include "grid_transfer_undef.inc"
 
-#define KERNEL_DIM 2
-#define WIDTH 3
-#define SHAPE bspline2_2d
-#define BASE base_bspline2
-#define LOCATE locate_b2_2d
-#define OFFSETS node_offsets_b2_2d
+#define STENCIL 3
+#include "grid_transfer_stencil.inc"
 #define P2G particles_to_grid_fields_apic_b2_2d
 #define M2G momentum_to_grid_fields_apic_b2_2d
 #define G2P grid_to_particles_fields_apic_b2_2d
-#define AFFINE_GRADIENT(j, a) (4.0_rp * grid%inv_h**2 * n(a) * d(j, a))
 #include "grid_transfer_kernels.inc"
 #include "grid_transfer_undef.inc"
 
-#define KERNEL_DIM 3
-#define WIDTH 3
-#define SHAPE bspline2_3d
-#define BASE base_bspline2
-#define LOCATE locate_b2_3d
-#define OFFSETS node_offsets_b2_3d
+#define STENCIL 4
+#include "grid_transfer_stencil.inc"
 #define P2G particles_to_grid_fields_apic_b2_3d
 #define M2G momentum_to_grid_fields_apic_b2_3d
 #define G2P grid_to_particles_fields_apic_b2_3d
-#define AFFINE_GRADIENT(j, a) (4.0_rp * grid%inv_h**2 * n(a) * d(j, a))
 #include "grid_transfer_kernels.inc"
 #include "grid_transfer_undef.inc"
 end module grid_transfer
