@@ -217,16 +217,24 @@ contains
    end subroutine grid_to_particles
 
    !> d(:, a) = x_a - x_p for the stencil nodes a of a particle at fractional position xi in a cell of
-   !> edge h, multilinear functions (APIC's offsets; exposed for the tests of D_p).
+   !> edge h, multilinear functions (APIC's offsets; exposed for the tests of D_p): node a's offset along
+   !> axis k from the cell's lower node, times h, from the kernels' per-axis table.
    pure subroutine node_offsets(dim, xi, h, d)
       integer, intent(in) :: dim
       real(rp), intent(in) :: xi(:), h
       real(rp), intent(out) :: d(:, :)
+      real(rp) :: per_axis(0:1, 3)
+      integer :: a, k
       if (dim == 2) then
-         call node_offsets_2d(xi, h, d)
+         call node_offsets_2d(xi, h, per_axis(:, 1:2))
       else
-         call node_offsets_3d(xi, h, d)
+         call node_offsets_3d(xi, h, per_axis)
       end if
+      do a = 1, 2**dim
+         do k = 1, dim
+            d(k, a) = per_axis(mod((a - 1) / 2**(k - 1), 2), k)
+         end do
+      end do
    end subroutine node_offsets
 
    !> o_i += sum_p N_ip m_p / rho_p over all particles (src/stabilization/volume_correction.f90).
@@ -262,7 +270,7 @@ contains
 ! APIC's C_p = B_p D_p^-1 = sum_a v_a (x) D_p^-1 (x_a - x_p) N_a (Jiang et al. 2015), per instance the term
 ! AFFINE_GRADIENT(j, a) = [D_p^-1 (x_a - x_p) N_a]_j: for multilinear functions it is grad N_a exactly, also
 ! on the grid lines where D_p is singular; for quadratic B-splines D_p = h^2/4 I at every position, so it
-! is (4 / h^2) (x_a - x_p) N_a, with d(:, a) = x_a - x_p from OFFSETS (docs/theory.md, "APIC").
+! is (4 / h^2) (x_a - x_p) N_a, with x_a - x_p from OFFSETS (docs/theory.md, "APIC").
 
 ! FLIP/PIC, single field: nodal velocities from the grid (and the volume and gradient kernels)
 #define BLEND flip_fraction,
