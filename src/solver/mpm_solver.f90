@@ -622,7 +622,7 @@ contains
       type(solver_t), intent(in) :: self
       real(rp), intent(out) :: speeds(:)
       integer :: m, first, last, p
-      real(rp) :: speed2
+      real(rp) :: speed2, rho_min
       speeds = 0.0_rp
       do m = 1, size(self%materials)
          first = self%particles%material_first(m)
@@ -631,11 +631,15 @@ contains
          if (self%run%fixed_dt > 0.0_rp) then
             speeds(2 * m) = sqrt(real(self%grid%dim, rp)) * maxval(abs(self%particles%v(:, first:last)))
          else
+            ! one pass over the particles for both (max and min are exact: the order does not matter); a NaN
+            ! density is passed over as minval does (the health check reports it)
             speed2 = 0.0_rp
+            rho_min = huge(1.0_rp)
             do p = first, last
                speed2 = max(speed2, sum(self%particles%v(:, p)**2))
+               if (self%particles%density(p) < rho_min) rho_min = self%particles%density(p)
             end do
-            speeds(2 * m - 1) = self%materials(m)%model%wave_speed(minval(self%particles%density(first:last)))
+            speeds(2 * m - 1) = self%materials(m)%model%wave_speed(rho_min)
             speeds(2 * m) = sqrt(speed2)
          end if
       end do
