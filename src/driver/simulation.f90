@@ -14,12 +14,14 @@ module simulation
    use kinds, only: rp, i8, name_len
    use mpi_f08, only: MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER, MPI_MAX
    use error_status, only: status_t
+   use communication_counters, only: count_collective, comm_health, int_bytes, comm_counts_t, communication_totals, &
+                                     counts_between
    use mpm_solver, only: solver_t
    use run_diagnostics, only: diagnostics_t, diagnostics_header, diagnostics_row, diagnostics_comments
    use provenance, only: written_by, continued_by, current_date, csv_reading_hint
    use csv_writer, only: csv_writer_t, keep_rows_until
    use load_records, only: load_records_t
-   use run_summary, only: write_run_summary, write_timing
+   use run_summary, only: write_run_summary, write_timing, write_communication
    use phase_timers, only: phase_health, phase_loads, phase_diagnostics, phase_output, phase_checkpoint, phase_rebalance, &
                            phase_other, phase_names
    use progress_reporter, only: progress_reporter_t
@@ -58,6 +60,7 @@ module simulation
       real(rp) :: speed_limit = 0.0_rp, density_limits(2) = 0.0_rp   !< blow-up limits
       real(rp) :: last_checkpoint_wall = 0.0_rp   !< reporter's clock at the latest checkpoint [s]
       integer(i8) :: last_checkpoint_step = 0, first_step = 0, particle_steps = 0
+      type(comm_counts_t) :: first_counts          !< communication_counters at the start of the loop
    end type time_loop_t
 
 contains
@@ -162,6 +165,7 @@ contains
       loop%last_checkpoint_wall = loop%reporter%elapsed()
       loop%last_checkpoint_step = solver%step
       loop%first_step = solver%step
+      loop%first_counts = communication_totals()
       loop%particle_steps = 0
       loop%outcome = 'finished'
       call solver%timers%reset()
@@ -195,6 +199,7 @@ contains
             flags(flag_wall_checkpoint) = 1
       end if
       call MPI_Allreduce(MPI_IN_PLACE, flags, size(flags), MPI_INTEGER, MPI_MAX, solver%domain%comm)
+      call count_collective(comm_health, size(flags), int_bytes)
       call solver%timers%switch_to(phase_other)
    end subroutine take_step
 
@@ -255,7 +260,7 @@ contains
    end subroutine checkpoint_if_due
 
    !> The final checkpoint (unless the loop just wrote it, or failed), close the files, and write
-   !> run_summary.csv and timing.csv. Collective.
+   !> run_summary.csv, timing.csv and communication.csv. Collective.
    subroutine finish_run(solver, progress, loop, status)
       type(solver_t), intent(inout) :: solver
       type(run_progress_t), intent(inout) :: progress
@@ -274,6 +279,8 @@ contains
       call write_run_summary(loop%dir, solver%domain%comm, loop%reporter%elapsed(), solver%step - loop%first_step, &
                              loop%particle_steps, loop%outcome, solver%time, summary_status)
       call write_timing(loop%dir, solver%domain%comm, solver%timers%seconds, phase_names, summary_status)
+      call write_communication(loop%dir, solver%domain%comm, counts_between(loop%first_counts, communication_totals()), &
+                               solver%step - loop%first_step, summary_status)
       if (status%ok .and. .not. summary_status%ok) status = summary_status
    end subroutine finish_run
 

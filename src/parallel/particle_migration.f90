@@ -6,6 +6,7 @@ module particle_migration
    use domain_decomposition, only: domain_t
    use background_grid, only: grid_t
    use particle_set, only: particle_set_t
+   use communication_counters, only: count_sent, comm_migration, int_bytes, real_bytes
    implicit none
    private
 
@@ -70,6 +71,7 @@ contains
             call MPI_Sendrecv(n_out(side), 1, MPI_INTEGER, domain%neighbour(side, k), tag_count, &
                               n_in(other), 1, MPI_INTEGER, domain%neighbour(other, k), tag_count, &
                               domain%comm, MPI_STATUS_IGNORE)
+            if (domain%neighbour(side, k) /= MPI_PROC_NULL) call count_sent(comm_migration, 1, int_bytes)
             if (domain%neighbour(other, k) == MPI_PROC_NULL) n_in(other) = 0
          end do
          do side = 1, 2
@@ -79,6 +81,8 @@ contains
                               domain%neighbour(side, k), tag_data, &
                               incoming, width * n_in(other), MPI_DOUBLE_PRECISION, &
                               domain%neighbour(other, k), tag_data, domain%comm, MPI_STATUS_IGNORE)
+            if (domain%neighbour(side, k) /= MPI_PROC_NULL) &
+               call count_sent(comm_migration, width * n_out(side), real_bytes)
             call particles%reserve(particles%count + n_in(other))
             first_new = particles%count + 1
             do p = 1, n_in(other)

@@ -16,6 +16,7 @@ module mpm_solver
                       MPI_INTEGER8
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use error_status, only: status_t
+   use communication_counters, only: count_collective, comm_time_step, comm_balance, comm_other, real_bytes, int8_bytes
    use scene_description, only: scene_t, run_control_t, wall_spec_t, model_newtonian_fluid
    use domain_decomposition, only: domain_t, layout_dims, fit_box, min_slab_width
    use shape_functions, only: shape_function_kind, ghost_node_layers
@@ -166,6 +167,7 @@ contains
          min_mass = min(min_mass, self%inlets(i)%particle_mass)
       end do
       call MPI_Allreduce(MPI_IN_PLACE, min_mass, 1, MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
+      call count_collective(comm_other, 1, real_bytes)
       self%mass_tolerance = 1.0e-12_rp * min_mass
       self%time = 0.0_rp
       self%step = 0
@@ -286,6 +288,7 @@ contains
       integer :: cuts(0:self%domain%nranks, 3)
       if (self%domain%nranks == 1 .or. self%run%rebalance_threshold <= 0.0_rp) return
       call MPI_Allgather(int(self%particles%count, i8), 1, MPI_INTEGER8, counts, 1, MPI_INTEGER8, self%domain%comm)
+      call count_collective(comm_balance, self%domain%nranks, int8_bytes)
       if (real(maxval(counts), rp) * self%domain%nranks <= self%run%rebalance_threshold * real(sum(counts), rp)) return
       call balanced_layout(self%domain, self%grid, self%particles, cuts, largest)
       ! no better layout (particles packed in fewer layers than the ranks need): keep this one
@@ -339,6 +342,7 @@ contains
       call particle_extent(self%particles, extent(1:3), extent(4:6))
       extent(4:6) = -extent(4:6)
       call MPI_Allreduce(MPI_IN_PLACE, extent, 6, MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
+      call count_collective(comm_balance, 6, real_bytes)
       call needed_cells(self, extent(1:3), -extent(4:6), need_lo, need_hi)
       call target_box(need_lo, need_hi, guard_cells(1.0_rp) + slack_cells, self%grid%global_cells, dim, box_lo, box_hi)
       call fit_box(self%domain%dims, self%grid%global_cells, box_lo, box_hi, self%domain%min_width)
@@ -608,6 +612,7 @@ contains
       call local_speeds(self, speeds)
       speeds = -speeds
       call MPI_Allreduce(MPI_IN_PLACE, speeds, size(speeds), MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
+      call count_collective(comm_time_step, size(speeds), real_bytes)
       call time_step_of_speeds(self, -speeds, dt, speed)
    end function solver_stable_time_step
 
@@ -696,6 +701,7 @@ contains
       call local_speeds(self, values(7:))
       values(7:) = -values(7:)
       call MPI_Allreduce(MPI_IN_PLACE, values, size(values), MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
+      call count_collective(comm_time_step, size(values), real_bytes)
       call time_step_of_speeds(self, -values(7:), self%dt, speed)
 
       ! a state that is no longer finite is the health check's business, not the layout's
