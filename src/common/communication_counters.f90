@@ -18,16 +18,15 @@ module communication_counters
    integer, parameter, public :: comm_cell_halo = 2      !< ghost cells of the face-flux smoothing (cell_halo)
    integer, parameter, public :: comm_migration = 3      !< particles to the face neighbours (particle_migration)
    integer, parameter, public :: comm_balance = 4        !< balance check, layout search, redistribution
-   integer, parameter, public :: comm_time_step = 5      !< the step's reduction (time step, extent) and init's
-   integer, parameter, public :: comm_health = 6         !< the time loop's flags (health, signals, checkpoint)
-   integer, parameter, public :: comm_volume = 7         !< the volume correction's surface heights
-   integer, parameter, public :: comm_records = 8        !< loads, gauges, bodies (load_interval)
-   integer, parameter, public :: comm_diagnostics = 9    !< diagnostics rows (output times)
-   integer, parameter, public :: comm_status = 10        !< status agreement and broadcast
-   integer, parameter, public :: comm_other = 11         !< scene, set-up, output, summaries
-   integer, parameter, public :: comm_categories = 11
+   integer, parameter, public :: comm_time_step = 5      !< the step's one reduction (time step, extent, loop flags)
+   integer, parameter, public :: comm_volume = 6         !< the volume correction's surface heights
+   integer, parameter, public :: comm_records = 7        !< loads, gauges, bodies (load_interval)
+   integer, parameter, public :: comm_diagnostics = 8    !< diagnostics rows (output times)
+   integer, parameter, public :: comm_status = 9         !< status agreement and broadcast
+   integer, parameter, public :: comm_other = 10         !< the solver's set-up
+   integer, parameter, public :: comm_categories = 10
    character(len=*), parameter :: names_(comm_categories) = [character(len=11) :: 'node_halo', 'cell_halo', &
-                                                             'migration', 'balance', 'time_step', 'health', 'volume', &
+                                                             'migration', 'balance', 'time_step', 'volume', &
                                                              'records', 'diagnostics', 'status', 'other']
    character(len=11), parameter, public :: comm_category_names(comm_categories) = names_
 

@@ -12,11 +12,9 @@
 !> take the same branch in the same step.
 module simulation
    use kinds, only: rp, i8, name_len
-   use mpi_f08, only: MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER, MPI_MAX
    use error_status, only: status_t
-   use communication_counters, only: count_collective, comm_health, int_bytes, comm_counts_t, communication_totals, &
-                                     counts_between
-   use mpm_solver, only: solver_t
+   use communication_counters, only: comm_counts_t, communication_totals, counts_between
+   use mpm_solver, only: solver_t, flag_unhealthy, flag_no_memory
    use run_diagnostics, only: diagnostics_t, diagnostics_header, diagnostics_row, diagnostics_comments
    use provenance, only: written_by, continued_by, current_date, csv_reading_hint
    use csv_writer, only: csv_writer_t, keep_rows_until
@@ -26,7 +24,7 @@ module simulation
                            phase_other, phase_names
    use progress_reporter, only: progress_reporter_t
    use status_broadcast, only: broadcast_status, agree_on_status
-   use health_check, only: particles_healthy, describe_unhealthy_particle
+   use health_check, only: describe_unhealthy_particle
    use termination_signals, only: install_termination_handlers, received_termination_signal, signal_name
    use run_progress, only: run_progress_t, scheduled_output_time, output_index_of
    use xdmf_writer, only: output_entry_t, write_particles_xdmf, write_grid_xdmf
@@ -45,7 +43,9 @@ module simulation
    real(rp), parameter :: density_limit_factor = 100.0_rp
 
    !> Positions of the flags agreed on after every step.
-   integer, parameter :: flag_unhealthy = 1, flag_signal = 2, flag_wall_checkpoint = 3, flag_no_memory = 4
+   !> The time loop's flags after flag_unhealthy and flag_no_memory (mpm_solver): they travel with the
+   !> step's reduction (solver_t%loop_flags).
+   integer, parameter :: flag_signal = 3, flag_wall_checkpoint = 4, loop_flag_count = 4
 
    !> What the time loop keeps from step to step besides the solver and the run's progress.
    type :: time_loop_t
@@ -128,6 +128,11 @@ contains
       loop%interval = solver%run%output_interval
       loop%speed_limit = blow_up_speed(solver)
       loop%density_limits = blow_up_densities(solver)
+      ! the flags travel with the step's reduction (take_step)
+      if (allocated(solver%loop_flags)) deallocate (solver%loop_flags)
+      allocate (solver%loop_flags(loop_flag_count))
+      solver%speed_limit = loop%speed_limit
+      solver%density_limits = loop%density_limits
       call open_diagnostics(solver, progress, loop%csv, status)
       if (.not. status%ok) return
       call loop%records%open(solver, progress, status)
@@ -172,8 +177,10 @@ contains
       call solver%timers%switch_to(phase_other)
    end subroutine start_run
 
-   !> One step, shortened to land exactly on the next output time, then the flags all ranks agree on
-   !> (one small reduction): an unhealthy particle, a termination signal, a wall-time checkpoint due.
+   !> One step, shortened to land exactly on the next output time, and the flags all ranks agree on: an
+   !> unhealthy particle, particle arrays that could not grow, a termination signal, a wall-time checkpoint
+   !> due. No reduction of their own: they travel with the step's (solver_t%loop_flags), so the signal and
+   !> the wall clock are read as the step starts, the particles' health as it ends.
    subroutine take_step(solver, progress, loop, flags)
       type(solver_t), intent(inout) :: solver
       type(run_progress_t), intent(in) :: progress
@@ -185,21 +192,18 @@ contains
       landing = solver%time + solver%dt * (1.0_rp + 1.0e-9_rp) >= progress%next_output_time
       if (landing) solver%dt = progress%next_output_time - solver%time
       loop%particle_steps = loop%particle_steps + solver%particles%count
-      call solver%advance()
-      if (landing) solver%time = progress%next_output_time
-      call loop%reporter%update(solver%time, solver%step, loop%diag%particles, solver%domain%rank == 0)
-
       call solver%timers%switch_to(phase_health)
-      flags = 0
-      if (.not. particles_healthy(solver%particles, loop%speed_limit, loop%density_limits)) flags(flag_unhealthy) = 1
-      flags(flag_signal) = received_termination_signal()
-      if (.not. solver%particles%allocation%ok) flags(flag_no_memory) = 1
+      solver%loop_flags = 0
+      solver%loop_flags(flag_signal) = received_termination_signal()
       if (solver%domain%rank == 0 .and. solver%run%checkpoint_interval_wall > 0.0_rp) then
          if (loop%reporter%elapsed() - loop%last_checkpoint_wall >= solver%run%checkpoint_interval_wall) &
-            flags(flag_wall_checkpoint) = 1
+            solver%loop_flags(flag_wall_checkpoint) = 1
       end if
-      call MPI_Allreduce(MPI_IN_PLACE, flags, size(flags), MPI_INTEGER, MPI_MAX, solver%domain%comm)
-      call count_collective(comm_health, size(flags), int_bytes)
+      call solver%timers%switch_to(phase_other)
+      call solver%advance()
+      flags = solver%loop_flags
+      if (landing) solver%time = progress%next_output_time
+      call loop%reporter%update(solver%time, solver%step, loop%diag%particles, solver%domain%rank == 0)
       call solver%timers%switch_to(phase_other)
    end subroutine take_step
 
