@@ -20,15 +20,16 @@ usage: scripts/scaling_model.py [rate_2d rate_3d]   (particle-steps/s on one ran
 import math
 import sys
 
-# measured on this machine (docs/performance.md): 1-rank particle-steps/s, flotsam_bench, Release
-RATE = {2: 12.1e6, 3: 5.9e6}
+# measured on the 2-core development machine 2026-11-25 (docs/performance.md): 1-rank particle-steps/s of
+# flotsam_bench on the bench water columns (300 and 100 steps), Release build
+RATE = {2: 12.06e6, 3: 5.41e6}
 if len(sys.argv) == 3:
     RATE = {2: float(sys.argv[1]), 3: float(sys.argv[2])}
 PPC = {2: 4, 3: 8}                  # particles per cell of the bench columns (2 per direction)
 RECORD = {2: 12 * 8, 3: 16 * 8}     # bytes of one migrating particle (particle_set%record_size)
 # particles crossing one face per step / particles of one cell layer at that face: measured on the
 # collapsing columns in full flow (flotsam, 4 ranks, scripts in docs/performance.md)
-PHI = {2: 0.004, 3: 0.004}
+PHI = {2: 0.0007, 3: 0.0002}
 NETWORKS = {"fast (1 us, 10 GB/s)": (1.0e-6, 10.0e9), "Ethernet (25 us, 1.2 GB/s)": (25.0e-6, 1.2e9)}
 REDUCTIONS_PER_STEP = 1
 REDUCTION_BYTES = 12 * 8
