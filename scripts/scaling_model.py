@@ -9,8 +9,8 @@ build/release). The messages are those scripts/bench_communication counts, writt
 rank's box of L cells per axis (a rank with a neighbour on every face, the slowest one):
   ghost-node sums (MUSL: two per step): per face neighbour one message each, (1 + 2 dim) and dim rows
       of 8-byte values over the (L + 1)^(dim - 1) nodes of the shared plane (multilinear shape);
-  migration: per face neighbour a count (4 bytes) and a message of the particles that crossed,
-      phi x (particles of one cell layer) x record bytes, phi measured on the collapsing column;
+  migration: per face neighbour one message of the particles that crossed (their number travels with
+      them), phi x (particles of one cell layer) x record bytes, phi measured on the collapsing columns;
   the step's one reduction (time step, extent, the time loop's flags: 12 doubles) and, every 20 steps,
       the balance check's allgather of P 8-byte counts.
 Messages are not overlapped with each other or with compute (an upper bound on the cost).
@@ -78,8 +78,8 @@ def step(dim, ranks, box, alpha, beta):
             for rows in (1 + 2 * dim, dim):     # the two ghost-node sums
                 halo += alpha + 8 * rows * plane_nodes / beta
                 halo_bytes += 8 * rows * plane_nodes
-            migration += 2 * alpha + (4 + PHI[dim] * layer * RECORD[dim]) / beta
-            messages += 4
+            migration += alpha + PHI[dim] * layer * RECORD[dim] / beta
+            messages += 3
     levels = math.ceil(math.log2(ranks)) if ranks > 1 else 0
     reductions = REDUCTIONS_PER_STEP * levels * (alpha + REDUCTION_BYTES / beta)
     balance = (levels * alpha + 8 * (ranks - 1) / beta) / BALANCE_INTERVAL if ranks > 1 else 0.0
