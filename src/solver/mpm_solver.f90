@@ -157,13 +157,16 @@ contains
       call self%bodies%init(scene, self%materials, frame, self%gravity)
       call self%contact%init(scene, self%bodies, size(self%materials))
 
-      call self%particles%init(scene%grid%dim, size(scene%materials), 1024, affine=scene%run%transfer == 'apic')
+      ! the spin only if some model reads it (the solids' Jaumann rate): a fluid scene holds none
+      call self%particles%init(scene%grid%dim, size(scene%materials), 1024, affine=scene%run%transfer == 'apic', &
+                               spin=any([(self%materials(i)%model%uses_spin, i = 1, size(self%materials))]))
       seed = .true.
       if (present(seed_particles)) seed = seed_particles
       if (seed) call seed_bodies(scene, self%grid, self%domain, self%particles)
       call self%check_particle_memory(status)
       if (.not. status%ok) return
       if (seed) call displace_fluid(self)
+      call self%particles%fit()
       if (seed) call check_structures_clear(self, status)
       if (.not. status%ok) return
       call update_cells(self%grid, self%particles)

@@ -147,6 +147,7 @@ contains
       logical :: spin
       spin = compute_strain
       if (present(compute_spin)) spin = compute_strain .and. compute_spin
+      spin = spin .and. particles%n_spin > 0       ! a set without spin (no model reads it)
       lo = 0.0_rp
       hi = 0.0_rp
       if (present(field)) then
