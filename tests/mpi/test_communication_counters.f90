@@ -38,7 +38,7 @@ contains
       type(solver_t) :: solver
       type(status_t) :: status
       type(comm_counts_t) :: counts
-      integer :: cells(3), split, k, ranks
+      integer :: ranks
       integer(i8) :: plane_nodes
       character(len=:), allocatable :: label
 
@@ -48,12 +48,7 @@ contains
       call solver%init(scene, comm, status)
       call assertTrue(status%ok, 'solver init: '//trim(status%message))
       if (.not. status%ok) return
-      cells = scene%grid%ncells
-      split = maxloc(cells(1:dim), dim=1)
-      plane_nodes = 1
-      do k = 1, dim
-         if (k /= split) plane_nodes = plane_nodes * (cells(k) + 1 + 2 * ghost)
-      end do
+      plane_nodes = shared_plane_nodes(scene%grid%ncells, dim, ghost)
       label = int_text(dim)//'-D, '//shape
       counts = communication_totals()
       call sum_shared_nodes(solver%domain, solver%grid, solver%grid%accumulated)
@@ -74,7 +69,7 @@ contains
       type(solver_t) :: solver
       type(status_t) :: status
       type(comm_counts_t) :: counts
-      integer :: cells(3), split, k, ranks, dim
+      integer :: ranks, dim
       integer(i8) :: plane_nodes
 
       call MPI_Comm_size(comm, ranks)
@@ -84,12 +79,7 @@ contains
       call solver%init(scene, comm, status)
       call assertTrue(status%ok, 'solver init: '//trim(status%message))
       if (.not. status%ok) return
-      cells = scene%grid%ncells
-      split = maxloc(cells(1:dim), dim=1)
-      plane_nodes = 1
-      do k = 1, dim
-         if (k /= split) plane_nodes = plane_nodes * (cells(k) + 1)
-      end do
+      plane_nodes = shared_plane_nodes(scene%grid%ncells, dim, 0)
       counts = communication_totals()
       call solver%advance()
       counts = counts_between(counts, communication_totals())
@@ -113,4 +103,16 @@ contains
       scene%grid%shape_function = shape
       call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], extent, 2, .true., extent(dim))
    end subroutine make_tank
+
+   !> Nodes of one node plane the 2 ranks share: the decomposition splits the longest axis, and a plane
+   !> across it holds cells + 1 + 2 ghost nodes along each other axis.
+   pure integer(i8) function shared_plane_nodes(cells, dim, ghost) result(nodes)
+      integer, intent(in) :: cells(3), dim, ghost
+      integer :: k, split
+      split = maxloc(cells(1:dim), dim=1)
+      nodes = 1
+      do k = 1, dim
+         if (k /= split) nodes = nodes * (cells(k) + 1 + 2 * ghost)
+      end do
+   end function shared_plane_nodes
 end module test_communication_counters
