@@ -4,6 +4,11 @@
 !>   grid_nodes layouts cpu_seconds
 !> preceded by a line of the timed steps' wall time per phase (phase_timers; the slowest rank's):
 !>   phases <name>=<seconds> ...
+!> and between the two by the table of what the timed steps sent per step and per rank, per category of
+!> communication (communication_counters; docs/performance.md, "Scaling model"), a header and one row per
+!> category and the total, each the mean over the ranks and the largest rank:
+!>   comm category messages_mean messages_max bytes_mean bytes_max collectives_mean collectives_max
+!>        collective_bytes_mean collective_bytes_max
 !> Memory per particle is the growth of the resident set from before the solver is built to after the
 !> timed steps, divided by the rank's particles (rank 0's view); peak_bytes the largest resident set
 !> of a rank (VmHWM); grid_nodes the nodes of all ranks' grids at the end; layouts how often the
@@ -33,6 +38,9 @@ program flotsam_bench
    use simulation, only: blow_up_speed, blow_up_densities
    use process_memory, only: resident_bytes, peak_resident_bytes
    use phase_timers, only: phase_names, phase_rebalance, phase_other
+   use communication_counters, only: comm_counts_t, communication_totals, counts_between, comm_categories, &
+                                     comm_category_names
+   use run_summary, only: communication_table, comm_columns
    implicit none
 
    type(scene_t) :: scene
@@ -43,6 +51,7 @@ program flotsam_bench
    integer :: rank, n_ranks, steps, step, warm_up
    real(rp) :: t0, t1, rss_before, rss_after, cpu0, cpu1, cpu
    integer(i8) :: peak, nodes
+   type(comm_counts_t) :: timed_counts
 
    call prefer_romio()     ! before MPI_Init: see src/domain/mpi_io_choice.f90
    call MPI_Init()
@@ -81,9 +90,11 @@ program flotsam_bench
    t0 = MPI_Wtime()
    call solver%timers%switch_to(phase_other)
    call cpu_time(cpu0)
+   timed_counts = communication_totals()
    do step = 1, steps
       call advance()
    end do
+   timed_counts = counts_between(timed_counts, communication_totals())
    call cpu_time(cpu1)
    call MPI_Barrier(MPI_COMM_WORLD)
    t1 = MPI_Wtime()
@@ -93,6 +104,7 @@ program flotsam_bench
    rss_after = real(resident_bytes(), rp)
    diag = solver%diagnostics()
    call print_phases()
+   call print_communication()
    peak = peak_resident_bytes()
    call MPI_Allreduce(MPI_IN_PLACE, peak, 1, MPI_INTEGER8, MPI_MAX, MPI_COMM_WORLD)
    nodes = solver%grid%node_count
@@ -130,6 +142,22 @@ contains
       write (output_unit, '(a)') ''
    end subroutine print_phases
 
+   !> The `comm` table: per category what the timed steps sent per step and per rank (mean, largest rank).
+   subroutine print_communication()
+      real(rp) :: mean(comm_columns, comm_categories + 1), largest(comm_columns, comm_categories + 1)
+      character(len=16) :: name
+      integer :: k, j
+      call communication_table(MPI_COMM_WORLD, timed_counts, int(steps, i8), mean, largest)
+      if (rank /= 0) return
+      write (output_unit, '(a)') 'comm category messages_mean messages_max bytes_mean bytes_max collectives_mean '// &
+         'collectives_max collective_bytes_mean collective_bytes_max'
+      do k = 1, comm_categories + 1
+         name = 'total'
+         if (k <= comm_categories) name = comm_category_names(k)
+         write (output_unit, '(a,1x,a11,*(1x,es12.5))') 'comm', name, (mean(j, k), largest(j, k), j = 1, comm_columns)
+      end do
+   end subroutine print_communication
+
    !> Time the output of the current state: fields file, checkpoint, health check (see the header).
    subroutine time_output(step_seconds)
       real(rp), intent(in) :: step_seconds
@@ -157,12 +185,14 @@ contains
       if (.not. status%ok) call bench_failure()
       speed_limit = blow_up_speed(solver)
       t0 = MPI_Wtime()
-      do k = 1, checks         ! as in the time loop: the local check and the agreement on 3 flags
+      ! as in the time loop: the local check (its flags travel with the step's reduction, no reduction here)
+      do k = 1, checks
          healthy = particles_healthy(solver%particles, speed_limit, blow_up_densities(solver))
-         flags = merge(0, 1, healthy)
-         call MPI_Allreduce(MPI_IN_PLACE, flags, 3, MPI_INTEGER, MPI_MAX, MPI_COMM_WORLD)
       end do
       health_seconds = (MPI_Wtime() - t0) / checks
+      flags = merge(0, 1, healthy)
+      call MPI_Allreduce(MPI_IN_PLACE, flags, 3, MPI_INTEGER, MPI_MAX, MPI_COMM_WORLD)
+      healthy = flags(1) == 0
       if (.not. healthy) health_seconds = -health_seconds     ! a blown-up bench state: say so
       if (rank == 0) write (output_unit, '(a,1x,i0,1x,i0,1x,i0,4(1x,es12.5))') 'output', scene%grid%dim, n_ranks, &
          diag%particles, step_seconds, fields_seconds, checkpoint_seconds, health_seconds

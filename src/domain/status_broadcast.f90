@@ -5,6 +5,7 @@ module status_broadcast
    use mpi_f08, only: MPI_Comm, MPI_Bcast, MPI_Allreduce, MPI_IN_PLACE, MPI_LOGICAL, MPI_CHARACTER, &
                       MPI_INTEGER, MPI_LAND, MPI_MIN, MPI_Comm_rank
    use error_status, only: status_t
+   use communication_counters, only: count_collective, comm_status, logical_bytes, int_bytes
    implicit none
    private
 
@@ -18,7 +19,11 @@ contains
       type(MPI_Comm), intent(in) :: comm
       integer, intent(in) :: root
       call MPI_Bcast(status%ok, 1, MPI_LOGICAL, root, comm)
-      if (.not. status%ok) call MPI_Bcast(status%message, message_len, MPI_CHARACTER, root, comm)
+      call count_collective(comm_status, 1, logical_bytes)
+      if (.not. status%ok) then
+         call MPI_Bcast(status%message, message_len, MPI_CHARACTER, root, comm)
+         call count_collective(comm_status, message_len, 1)
+      end if
    end subroutine broadcast_status
 
    !> Fail everywhere if any rank failed; the message of the lowest failing rank is kept. Collective.
@@ -29,10 +34,12 @@ contains
       logical :: all_ok
       all_ok = status%ok
       call MPI_Allreduce(MPI_IN_PLACE, all_ok, 1, MPI_LOGICAL, MPI_LAND, comm)
+      call count_collective(comm_status, 1, logical_bytes)
       if (all_ok) return
       call MPI_Comm_rank(comm, rank)
       first_failing = merge(huge(1), rank, status%ok)
       call MPI_Allreduce(MPI_IN_PLACE, first_failing, 1, MPI_INTEGER, MPI_MIN, comm)
+      call count_collective(comm_status, 1, int_bytes)
       call broadcast_status(status, comm, first_failing)
    end subroutine agree_on_status
 end module status_broadcast

@@ -12,19 +12,19 @@
 !> take the same branch in the same step.
 module simulation
    use kinds, only: rp, i8, name_len
-   use mpi_f08, only: MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER, MPI_MAX
    use error_status, only: status_t
-   use mpm_solver, only: solver_t
+   use communication_counters, only: comm_counts_t, communication_totals, counts_between
+   use mpm_solver, only: solver_t, flag_unhealthy, flag_no_memory
    use run_diagnostics, only: diagnostics_t, diagnostics_header, diagnostics_row, diagnostics_comments
    use provenance, only: written_by, continued_by, current_date, csv_reading_hint
    use csv_writer, only: csv_writer_t, keep_rows_until
    use load_records, only: load_records_t
-   use run_summary, only: write_run_summary, write_timing
+   use run_summary, only: write_run_summary, write_timing, write_communication
    use phase_timers, only: phase_health, phase_loads, phase_diagnostics, phase_output, phase_checkpoint, phase_rebalance, &
                            phase_other, phase_names
    use progress_reporter, only: progress_reporter_t
    use status_broadcast, only: broadcast_status, agree_on_status
-   use health_check, only: particles_healthy, describe_unhealthy_particle
+   use health_check, only: describe_unhealthy_particle
    use termination_signals, only: install_termination_handlers, received_termination_signal, signal_name
    use run_progress, only: run_progress_t, scheduled_output_time, output_index_of
    use xdmf_writer, only: output_entry_t, write_particles_xdmf, write_grid_xdmf
@@ -43,7 +43,9 @@ module simulation
    real(rp), parameter :: density_limit_factor = 100.0_rp
 
    !> Positions of the flags agreed on after every step.
-   integer, parameter :: flag_unhealthy = 1, flag_signal = 2, flag_wall_checkpoint = 3, flag_no_memory = 4
+   !> The time loop's flags after flag_unhealthy and flag_no_memory (mpm_solver): they travel with the
+   !> step's reduction (solver_t%loop_flags).
+   integer, parameter :: flag_signal = 3, flag_wall_checkpoint = 4, loop_flag_count = 4
 
    !> What the time loop keeps from step to step besides the solver and the run's progress.
    type :: time_loop_t
@@ -58,6 +60,7 @@ module simulation
       real(rp) :: speed_limit = 0.0_rp, density_limits(2) = 0.0_rp   !< blow-up limits
       real(rp) :: last_checkpoint_wall = 0.0_rp   !< reporter's clock at the latest checkpoint [s]
       integer(i8) :: last_checkpoint_step = 0, first_step = 0, particle_steps = 0
+      type(comm_counts_t) :: first_counts          !< communication_counters at the start of the loop
    end type time_loop_t
 
 contains
@@ -125,6 +128,11 @@ contains
       loop%interval = solver%run%output_interval
       loop%speed_limit = blow_up_speed(solver)
       loop%density_limits = blow_up_densities(solver)
+      ! the flags travel with the step's reduction (take_step)
+      if (allocated(solver%loop_flags)) deallocate (solver%loop_flags)
+      allocate (solver%loop_flags(loop_flag_count))
+      solver%speed_limit = loop%speed_limit
+      solver%density_limits = loop%density_limits
       call open_diagnostics(solver, progress, loop%csv, status)
       if (.not. status%ok) return
       call loop%records%open(solver, progress, status)
@@ -162,14 +170,17 @@ contains
       loop%last_checkpoint_wall = loop%reporter%elapsed()
       loop%last_checkpoint_step = solver%step
       loop%first_step = solver%step
+      loop%first_counts = communication_totals()
       loop%particle_steps = 0
       loop%outcome = 'finished'
       call solver%timers%reset()
       call solver%timers%switch_to(phase_other)
    end subroutine start_run
 
-   !> One step, shortened to land exactly on the next output time, then the flags all ranks agree on
-   !> (one small reduction): an unhealthy particle, a termination signal, a wall-time checkpoint due.
+   !> One step, shortened to land exactly on the next output time, and the flags all ranks agree on: an
+   !> unhealthy particle, particle arrays that could not grow, a termination signal, a wall-time checkpoint
+   !> due. No reduction of their own: they travel with the step's (solver_t%loop_flags), so the signal and
+   !> the wall clock are read as the step starts, the particles' health as it ends.
    subroutine take_step(solver, progress, loop, flags)
       type(solver_t), intent(inout) :: solver
       type(run_progress_t), intent(in) :: progress
@@ -181,20 +192,18 @@ contains
       landing = solver%time + solver%dt * (1.0_rp + 1.0e-9_rp) >= progress%next_output_time
       if (landing) solver%dt = progress%next_output_time - solver%time
       loop%particle_steps = loop%particle_steps + solver%particles%count
-      call solver%advance()
-      if (landing) solver%time = progress%next_output_time
-      call loop%reporter%update(solver%time, solver%step, loop%diag%particles, solver%domain%rank == 0)
-
       call solver%timers%switch_to(phase_health)
-      flags = 0
-      if (.not. particles_healthy(solver%particles, loop%speed_limit, loop%density_limits)) flags(flag_unhealthy) = 1
-      flags(flag_signal) = received_termination_signal()
-      if (.not. solver%particles%allocation%ok) flags(flag_no_memory) = 1
+      solver%loop_flags = 0
+      solver%loop_flags(flag_signal) = received_termination_signal()
       if (solver%domain%rank == 0 .and. solver%run%checkpoint_interval_wall > 0.0_rp) then
          if (loop%reporter%elapsed() - loop%last_checkpoint_wall >= solver%run%checkpoint_interval_wall) &
-            flags(flag_wall_checkpoint) = 1
+            solver%loop_flags(flag_wall_checkpoint) = 1
       end if
-      call MPI_Allreduce(MPI_IN_PLACE, flags, size(flags), MPI_INTEGER, MPI_MAX, solver%domain%comm)
+      call solver%timers%switch_to(phase_other)
+      call solver%advance()
+      flags = solver%loop_flags
+      if (landing) solver%time = progress%next_output_time
+      call loop%reporter%update(solver%time, solver%step, loop%diag%particles, solver%domain%rank == 0)
       call solver%timers%switch_to(phase_other)
    end subroutine take_step
 
@@ -255,7 +264,7 @@ contains
    end subroutine checkpoint_if_due
 
    !> The final checkpoint (unless the loop just wrote it, or failed), close the files, and write
-   !> run_summary.csv and timing.csv. Collective.
+   !> run_summary.csv, timing.csv and communication.csv. Collective.
    subroutine finish_run(solver, progress, loop, status)
       type(solver_t), intent(inout) :: solver
       type(run_progress_t), intent(inout) :: progress
@@ -274,6 +283,8 @@ contains
       call write_run_summary(loop%dir, solver%domain%comm, loop%reporter%elapsed(), solver%step - loop%first_step, &
                              loop%particle_steps, loop%outcome, solver%time, summary_status)
       call write_timing(loop%dir, solver%domain%comm, solver%timers%seconds, phase_names, summary_status)
+      call write_communication(loop%dir, solver%domain%comm, counts_between(loop%first_counts, communication_totals()), &
+                               solver%step - loop%first_step, summary_status)
       if (status%ok .and. .not. summary_status%ok) status = summary_status
    end subroutine finish_run
 

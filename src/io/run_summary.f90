@@ -8,7 +8,11 @@
 !> `timing.csv` beside it: the time loop's wall time per phase (phase_timers), one row per phase:
 !>   phase, seconds_max (the slowest rank's), seconds_mean (over the ranks), share (of the mean loop time)
 !> and a last row `total` (seconds_max: the largest of the ranks' sums, not the sum of the maxima).
-!> Both have the CSV layout of every file a run writes: header row, '#' comment lines (provenance, units).
+!> `communication.csv`: what the time loop sent per step and per rank, per category of communication
+!> (communication_counters), one row per category and a last row `total`:
+!>   category, messages_mean, messages_max, bytes_mean, bytes_max, collectives_mean, collectives_max,
+!>   collective_bytes_mean, collective_bytes_max (mean and largest over the ranks).
+!> All have the CSV layout of every file a run writes: header row, '#' comment lines (provenance, units).
 module run_summary
    use, intrinsic :: iso_fortran_env, only: error_unit
    use kinds, only: rp, i8
@@ -20,12 +24,17 @@ module run_summary
    use output_layout, only: temporary_suffix
    use file_system, only: rename_path
    use provenance, only: written_by, current_date, csv_reading_hint
+   use communication_counters, only: comm_counts_t, comm_categories, comm_category_names
    implicit none
    private
 
-   character(len=*), parameter, public :: run_summary_file = 'run_summary.csv', timing_file = 'timing.csv'
+   character(len=*), parameter, public :: run_summary_file = 'run_summary.csv', timing_file = 'timing.csv', &
+                                          communication_file = 'communication.csv'
 
-   public :: write_run_summary, write_timing
+   !> Columns of the communication table: per step per rank messages, bytes, collectives, collective bytes.
+   integer, parameter, public :: comm_columns = 4
+
+   public :: write_run_summary, write_timing, communication_table, write_communication
 
 contains
 
@@ -102,6 +111,66 @@ contains
       write (unit, '(a)') 'total,'//real_text(largest_total)//','//real_text(total)//',1'
       call publish(dir, timing_file, unit, status)
    end subroutine write_timing
+
+   !> Per category (and a last row, the sum of all) the mean over the ranks and the largest rank's
+   !> messages, bytes, collective calls and collective bytes per step, from this rank's `counts` over
+   !> `steps` steps. Collective over `comm` (two reductions, which are not counted themselves).
+   subroutine communication_table(comm, counts, steps, mean, largest)
+      type(MPI_Comm), intent(in) :: comm
+      type(comm_counts_t), intent(in) :: counts
+      integer(i8), intent(in) :: steps
+      real(rp), intent(out) :: mean(comm_columns, comm_categories + 1), largest(comm_columns, comm_categories + 1)
+      integer(i8) :: local(comm_columns, comm_categories + 1), summed(comm_columns, comm_categories + 1)
+      integer :: ranks
+      call MPI_Comm_size(comm, ranks)
+      local(1, 1:comm_categories) = counts%messages
+      local(2, 1:comm_categories) = counts%bytes
+      local(3, 1:comm_categories) = counts%collectives
+      local(4, 1:comm_categories) = counts%collective_bytes
+      local(:, comm_categories + 1) = sum(local(:, 1:comm_categories), dim=2)
+      call MPI_Allreduce(local, summed, size(local), MPI_INTEGER8, MPI_SUM, comm)
+      mean = real(summed, rp) / (real(ranks, rp) * max(1_i8, steps))
+      call MPI_Allreduce(MPI_IN_PLACE, local, size(local), MPI_INTEGER8, MPI_MAX, comm)
+      largest = real(local, rp) / max(1_i8, steps)
+   end subroutine communication_table
+
+   !> Collective over `comm`: rank 0 writes <dir>/communication.csv (replacing it) from every rank's
+   !> `counts` over the loop's `steps` steps (communication_table).
+   subroutine write_communication(dir, comm, counts, steps, status)
+      character(len=*), intent(in) :: dir
+      type(MPI_Comm), intent(in) :: comm
+      type(comm_counts_t), intent(in) :: counts
+      integer(i8), intent(in) :: steps
+      type(status_t), intent(inout) :: status
+      real(rp) :: mean(comm_columns, comm_categories + 1), largest(comm_columns, comm_categories + 1)
+      character(len=16) :: names(comm_categories + 1)
+      integer :: rank, ranks, unit, k, j
+      character(len=:), allocatable :: row
+
+      call communication_table(comm, counts, steps, mean, largest)
+      call MPI_Comm_rank(comm, rank)
+      call MPI_Comm_size(comm, ranks)
+      if (rank /= 0) return
+      if (.not. opened(dir, communication_file, unit, status)) return
+      write (unit, '(a)') 'category,messages_mean,messages_max,bytes_mean,bytes_max,collectives_mean,'// &
+         'collectives_max,collective_bytes_mean,collective_bytes_max'
+      write (unit, '(a)') written_by(ranks, current_date()), &
+         '# communication.csv: what one rank sent per step of this invocation''s time loop, per category '// &
+         '(docs/performance.md, Scaling model); mean over the ranks and the largest rank; the last row, total, '// &
+         'sums the categories per rank', &
+         '# units: messages count/step (point-to-point); bytes B/step; collectives count/step; '// &
+         'collective_bytes B/step (payload: the buffer one rank holds after the call)', csv_reading_hint
+      names(1:comm_categories) = comm_category_names
+      names(comm_categories + 1) = 'total'
+      do k = 1, comm_categories + 1
+         row = trim(names(k))
+         do j = 1, comm_columns
+            row = row//','//real_text(mean(j, k))//','//real_text(largest(j, k))
+         end do
+         write (unit, '(a)') row
+      end do
+      call publish(dir, communication_file, unit, status)
+   end subroutine write_communication
 
    !> The run's last line on standard error (rank 0): what ended it and what it cost.
    subroutine print_final_line(outcome, steps, simulated_time, wall_seconds, particle_steps_per_second)

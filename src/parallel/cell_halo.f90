@@ -9,6 +9,7 @@ module cell_halo
    use kinds, only: rp
    use mpi_f08, only: MPI_PROC_NULL
    use face_exchange, only: exchange_with_face_neighbours
+   use communication_counters, only: comm_cell_halo
    use domain_decomposition, only: domain_t
    use background_grid, only: grid_t
    implicit none
@@ -110,7 +111,7 @@ contains
          do side = 1, 2
             call copy_layers(grid, box, k, first_owned(side), field, send_buf(:, side), to_buffer=.true.)
          end do
-         call exchange_with_face_neighbours(domain, k, send_buf, recv_buf, tag)
+         call exchange_with_face_neighbours(domain, k, send_buf, recv_buf, tag, comm_cell_halo)
          do side = 1, 2
             if (domain%neighbour(side, k) /= MPI_PROC_NULL) &
                call copy_layers(grid, box, k, first_ghost(side), field, recv_buf(:, side), to_buffer=.false.)

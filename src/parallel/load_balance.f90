@@ -14,6 +14,7 @@ module load_balance
    use domain_decomposition, only: domain_t, min_slab_width
    use background_grid, only: grid_t
    use particle_set, only: particle_set_t
+   use communication_counters, only: count_collective, comm_balance, int8_bytes
    implicit none
    private
 
@@ -114,6 +115,7 @@ contains
          end do
       end do
       call MPI_Allreduce(MPI_IN_PLACE, histogram, size(histogram), MPI_INTEGER8, MPI_SUM, domain%comm)
+      call count_collective(comm_balance, size(histogram), int8_bytes)
 
       grids = rank_grids(domain%nranks, domain%dim, n, domain%min_width)
       allocate (candidate_cuts(0:domain%nranks, 3, size(grids, 2)), loads(0:domain%nranks - 1, size(grids, 2)))
@@ -142,6 +144,7 @@ contains
          end do
       end do
       call MPI_Allreduce(MPI_IN_PLACE, loads, size(loads), MPI_INTEGER8, MPI_SUM, domain%comm)
+      call count_collective(comm_balance, size(loads), int8_bytes)
 
       best = 0
       worst = huge(1_i8)

@@ -11,6 +11,7 @@ module node_halo
    use kinds, only: rp
    use mpi_f08, only: MPI_PROC_NULL
    use face_exchange, only: exchange_with_face_neighbours
+   use communication_counters, only: comm_node_halo
    use domain_decomposition, only: domain_t
    use background_grid, only: grid_t
    implicit none
@@ -44,7 +45,7 @@ contains
                                send_buf(layer * count + 1:(layer + 1) * count, side))
             end do
          end do
-         call exchange_with_face_neighbours(domain, k, send_buf, recv_buf, tag)
+         call exchange_with_face_neighbours(domain, k, send_buf, recv_buf, tag, comm_node_halo)
          do side = 1, 2
             if (domain%neighbour(side, k) == MPI_PROC_NULL) cycle
             do layer = 0, layers - 1

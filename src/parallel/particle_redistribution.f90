@@ -9,6 +9,7 @@ module particle_redistribution
    use background_grid, only: grid_t
    use particle_set, only: particle_set_t
    use status_broadcast, only: agree_on_status
+   use communication_counters, only: count_collective, comm_balance, int_bytes, real_bytes
    implicit none
    private
 
@@ -59,6 +60,7 @@ contains
 
       width = particles%record_size()
       call MPI_Alltoall(send_counts, 1, MPI_INTEGER, receive_counts, 1, MPI_INTEGER, domain%comm)
+      call count_collective(comm_balance, domain%nranks, int_bytes)
       allocate (send_first(0:domain%nranks - 1), receive_first(0:domain%nranks - 1), next(0:domain%nranks - 1))
       send_first(0) = 0
       receive_first(0) = 0
@@ -75,6 +77,7 @@ contains
       end do
       call MPI_Alltoallv(outgoing, width * send_counts, width * send_first, MPI_DOUBLE_PRECISION, &
                          incoming, width * receive_counts, width * receive_first, MPI_DOUBLE_PRECISION, domain%comm)
+      call count_collective(comm_balance, width * (particles%count - send_counts(domain%rank)), real_bytes)
 
       particles%count = 0
       call particles%reserve(n_in)

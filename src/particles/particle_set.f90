@@ -5,7 +5,8 @@
 !> matrix C_p (docs/theory.md, "APIC"; not allocated otherwise: n_affine = 0). Scratch per step: the (filtered) rate of deformation
 !> and the spin. After `sort_by_material_and_cell` the particles of material m occupy the contiguous
 !> range material_first(m):material_last(m), ordered by cell, so material updates and cell sums run
-!> over contiguous slices.
+!> over contiguous slices. The sort permutes the arrays in place (no second copy of the set); the
+!> arrays grow by an eighth when full (docs/performance.md, "Memory per particle").
 !>
 !> Growing the arrays can fail for want of memory: `allocation` then fails (the first failure wins),
 !> the set keeps the particles it had (an `add` that finds no room drops its particle), and the caller
@@ -20,7 +21,8 @@ module particle_set
    private
 
    type, public :: particle_set_t
-      integer :: dim = 2, n_sigma = 4, n_spin = 1, n_materials = 1
+      integer :: dim = 2, n_sigma = 4, n_materials = 1
+      integer :: n_spin = 1                         !< spin components, 0 when no model reads the spin
       integer :: n_affine = 0                       !< dim**2 with APIC, else 0
       integer :: count = 0                          !< particles held
       real(rp), allocatable :: x(:, :)              !< position (dim, p), grid frame [m]
@@ -40,7 +42,8 @@ module particle_set
    contains
       procedure :: init => particles_init
       procedure :: reserve => particles_reserve
-      procedure :: reorder => particles_reorder
+      procedure :: fit => particles_fit
+      procedure :: permute => particles_permute
       procedure :: record_size => particles_record_size
       procedure :: pack_record => particles_pack_record
       procedure :: append_record => particles_append_record
@@ -51,14 +54,18 @@ module particle_set
 
 contains
 
-   !> An empty set; `affine` (default .false.): carry APIC's affine matrix per particle.
-   subroutine particles_init(self, dim, n_materials, capacity, affine)
+   !> An empty set; `affine` (default .false.): carry APIC's affine matrix per particle; `spin` (default
+   !> .true.): hold the spin (only a model with uses_spin reads it).
+   subroutine particles_init(self, dim, n_materials, capacity, affine, spin)
       class(particle_set_t), intent(inout) :: self
       integer, intent(in) :: dim, n_materials, capacity
-      logical, intent(in), optional :: affine
+      logical, intent(in), optional :: affine, spin
       self%dim = dim
       self%n_sigma = n_components(dim)
       self%n_spin = n_spin(dim)
+      if (present(spin)) then
+         if (.not. spin) self%n_spin = 0
+      end if
       self%n_affine = 0
       if (present(affine)) then
          if (affine) self%n_affine = dim * dim
@@ -122,33 +129,41 @@ contains
       if (allocated(self%affine)) deallocate (self%affine)
    end subroutine free_arrays
 
-   !> Make room for at least `capacity` particles, keeping the first `count`.
+   !> Make room for at least `capacity` particles, keeping the first `count`. Growing takes an eighth
+   !> more than asked: repeated small growths (arrivals every step, an inlet's particles) then copy
+   !> the set only now and then, and the slack stays small (pages never written are not resident).
    subroutine particles_reserve(self, capacity)
       class(particle_set_t), intent(inout) :: self
       integer, intent(in) :: capacity
-      integer :: p
       if (capacity <= size(self%mass)) return
-      call self%reorder([(p, p = 1, self%count)], capacity)
+      call resize(self, max(capacity, size(self%mass) + size(self%mass) / 8))
    end subroutine particles_reserve
 
-   !> Move particle p to slot dest(p) (a permutation of 1..count) in arrays of `capacity` slots.
-   !> The scratch arrays (rate of deformation, spin) are not carried: they are rebuilt every step.
-   !> Without memory for a new array the set is left as it was before that array (arrays already moved
-   !> stay moved: the contents are then inconsistent, and the run stops at the end of the step).
-   subroutine particles_reorder(self, dest, capacity)
+   !> Let the arrays hold just the particles held (after removals: the structures' displaced fluid).
+   subroutine particles_fit(self)
       class(particle_set_t), intent(inout) :: self
-      integer, intent(in) :: dest(:), capacity
+      if (size(self%mass) > max(self%count, 16)) call resize(self, max(self%count, 16))
+   end subroutine particles_fit
+
+   !> Arrays of `capacity` slots holding the first `count` particles. The scratch arrays (rate of
+   !> deformation, spin) are not carried: they are rebuilt every step. Without memory for a new array
+   !> the set is left as it was before that array (arrays already moved stay moved: the contents are
+   !> then inconsistent, and the run stops at the end of the step).
+   subroutine resize(self, capacity)
+      type(particle_set_t), intent(inout) :: self
+      integer, intent(in) :: capacity
       logical :: ok
-      integer :: stat
-      ok = reorder_real2(self%x, dest, capacity)
-      if (ok) ok = reorder_real2(self%v, dest, capacity)
-      if (ok) ok = reorder_real1(self%mass, dest, capacity)
-      if (ok) ok = reorder_real1(self%density, dest, capacity)
-      if (ok) ok = reorder_real2(self%sbar, dest, capacity)
-      if (ok) ok = reorder_real2(self%affine, dest, capacity)
-      if (ok) ok = reorder_int1(self%material, dest, capacity)
-      if (ok) ok = reorder_int1(self%cell, dest, capacity)
-      if (ok) ok = reorder_i8(self%id, dest, capacity)
+      integer :: stat, n
+      n = min(self%count, capacity)
+      ok = resize_real2(self%x, n, capacity)
+      if (ok) ok = resize_real2(self%v, n, capacity)
+      if (ok) ok = resize_real1(self%mass, n, capacity)
+      if (ok) ok = resize_real1(self%density, n, capacity)
+      if (ok) ok = resize_real2(self%sbar, n, capacity)
+      if (ok) ok = resize_real2(self%affine, n, capacity)
+      if (ok) ok = resize_int1(self%material, n, capacity)
+      if (ok) ok = resize_int1(self%cell, n, capacity)
+      if (ok) ok = resize_i8(self%id, n, capacity)
       if (ok .and. capacity /= size(self%strain_rate, 2)) then
          deallocate (self%strain_rate, self%spin)
          allocate (self%strain_rate(self%n_sigma, capacity), self%spin(self%n_spin, capacity), stat=stat)
@@ -160,65 +175,134 @@ contains
          end if
       end if
       if (.not. ok) call no_memory(self, capacity)
-   end subroutine particles_reorder
+   end subroutine resize
 
-   ! One routine per array type (Fortran has no generics over types): b(dest(p)) = a(p); false (a
-   ! unchanged) without memory for b.
-   logical function reorder_real2(a, dest, capacity) result(ok)
+   !> Move particle p to slot dest(p) (a permutation of 1..count), in place: each cycle of the
+   !> permutation is followed carrying one particle, so the sort needs no second copy of the set (which
+   !> would double the particle memory at every sort). dest is marked while the cycles are followed
+   !> (negative: done) and restored on return. The scratch arrays are not carried.
+   subroutine particles_permute(self, dest)
+      class(particle_set_t), intent(inout) :: self
+      integer, intent(inout) :: dest(:)
+      real(rp) :: x(3), v(3), sbar(6), affine(9), mass, density
+      integer :: start, p, q, d, s, a, material, cell
+      integer(i8) :: id
+      d = self%dim
+      s = self%n_sigma
+      a = self%n_affine
+      do start = 1, size(dest)
+         if (dest(start) <= 0 .or. dest(start) == start) cycle
+         ! carry particle `start` to its slot, pick up the one there, and so on round the cycle
+         x(1:d) = self%x(:, start)
+         v(1:d) = self%v(:, start)
+         mass = self%mass(start)
+         density = self%density(start)
+         sbar(1:s) = self%sbar(:, start)
+         affine(1:a) = self%affine(:, start)
+         material = self%material(start)
+         cell = self%cell(start)
+         id = self%id(start)
+         p = start
+         do
+            q = dest(p)
+            dest(p) = -q
+            call swap_real(self%x(:, q), x(1:d))
+            call swap_real(self%v(:, q), v(1:d))
+            call swap_real1(self%mass(q), mass)
+            call swap_real1(self%density(q), density)
+            call swap_real(self%sbar(:, q), sbar(1:s))
+            call swap_real(self%affine(:, q), affine(1:a))
+            call swap_int(self%material(q), material)
+            call swap_int(self%cell(q), cell)
+            call swap_i8(self%id(q), id)
+            if (q == start) exit
+            p = q
+         end do
+      end do
+      dest = abs(dest)
+   end subroutine particles_permute
+
+   pure subroutine swap_real(slot, held)
+      real(rp), intent(inout) :: slot(:), held(:)
+      real(rp) :: t(size(slot))
+      t = slot
+      slot = held
+      held = t
+   end subroutine swap_real
+
+   pure subroutine swap_real1(slot, held)
+      real(rp), intent(inout) :: slot, held
+      real(rp) :: t
+      t = slot
+      slot = held
+      held = t
+   end subroutine swap_real1
+
+   pure subroutine swap_int(slot, held)
+      integer, intent(inout) :: slot, held
+      integer :: t
+      t = slot
+      slot = held
+      held = t
+   end subroutine swap_int
+
+   pure subroutine swap_i8(slot, held)
+      integer(i8), intent(inout) :: slot, held
+      integer(i8) :: t
+      t = slot
+      slot = held
+      held = t
+   end subroutine swap_i8
+
+   ! One routine per array type (Fortran has no generics over types): b(:n) = a(:n) in a new array of
+   ! `capacity` slots; false (a unchanged) without memory for b.
+   logical function resize_real2(a, n, capacity) result(ok)
       real(rp), allocatable, intent(inout) :: a(:, :)
-      integer, intent(in) :: dest(:), capacity
+      integer, intent(in) :: n, capacity
       real(rp), allocatable :: b(:, :)
-      integer :: p, stat
+      integer :: stat
       allocate (b(size(a, 1), capacity), stat=stat)
       ok = stat == 0
       if (.not. ok) return
-      do p = 1, size(dest)
-         b(:, dest(p)) = a(:, p)
-      end do
+      b(:, 1:n) = a(:, 1:n)
       call move_alloc(b, a)
-   end function reorder_real2
+   end function resize_real2
 
-   logical function reorder_real1(a, dest, capacity) result(ok)
+   logical function resize_real1(a, n, capacity) result(ok)
       real(rp), allocatable, intent(inout) :: a(:)
-      integer, intent(in) :: dest(:), capacity
+      integer, intent(in) :: n, capacity
       real(rp), allocatable :: b(:)
-      integer :: p, stat
+      integer :: stat
       allocate (b(capacity), stat=stat)
       ok = stat == 0
       if (.not. ok) return
-      do p = 1, size(dest)
-         b(dest(p)) = a(p)
-      end do
+      b(1:n) = a(1:n)
       call move_alloc(b, a)
-   end function reorder_real1
+   end function resize_real1
 
-   logical function reorder_int1(a, dest, capacity) result(ok)
+   logical function resize_int1(a, n, capacity) result(ok)
       integer, allocatable, intent(inout) :: a(:)
-      integer, intent(in) :: dest(:), capacity
+      integer, intent(in) :: n, capacity
       integer, allocatable :: b(:)
-      integer :: p, stat
+      integer :: stat
       allocate (b(capacity), stat=stat)
       ok = stat == 0
       if (.not. ok) return
-      do p = 1, size(dest)
-         b(dest(p)) = a(p)
-      end do
+      b(1:n) = a(1:n)
       call move_alloc(b, a)
-   end function reorder_int1
+   end function resize_int1
 
-   logical function reorder_i8(a, dest, capacity) result(ok)
+   logical function resize_i8(a, n, capacity) result(ok)
       integer(i8), allocatable, intent(inout) :: a(:)
-      integer, intent(in) :: dest(:), capacity
+      integer, intent(in) :: n, capacity
       integer(i8), allocatable :: b(:)
-      integer :: p, stat
+      integer :: stat
       allocate (b(capacity), stat=stat)
       ok = stat == 0
       if (.not. ok) return
-      do p = 1, size(dest)
-         b(dest(p)) = a(p)
-      end do
+      b(1:n) = a(1:n)
       call move_alloc(b, a)
-   end function reorder_i8
+   end function resize_i8
 
    !> Reals needed to carry one particle's persistent state between ranks.
    pure integer function particles_record_size(self)
@@ -267,7 +351,7 @@ contains
       integer :: p
       if (.not. self%allocation%ok) return      ! no memory: the run stops at the end of the step
       if (self%count == size(self%mass)) then
-         call self%reserve(max(16, self%count + self%count / 2))
+         call self%reserve(max(16, self%count + 1))
          if (.not. self%allocation%ok) return
       end if
       p = self%count + 1

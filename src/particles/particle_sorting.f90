@@ -24,20 +24,22 @@ contains
    end subroutine update_cells
 
    !> Sort by (material, particles%cell) and set the material ranges. particles%cell must be current
-   !> (update_cells, or migrate_particles which sets it).
+   !> (update_cells, or migrate_particles which sets it). Scratch: the destinations (4 bytes per
+   !> particle) and the counts per key; the keys are recomputed rather than stored, and the particles
+   !> are permuted in place.
    subroutine sort_by_material_and_cell(grid, particles)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
-      integer, allocatable :: key(:), start(:), dest(:)
-      integer :: p, n, n_keys, m
+      integer, allocatable :: start(:), dest(:)
+      integer :: p, n, n_keys, m, k
 
       n = particles%count
       n_keys = particles%n_materials * grid%cell_count
-      allocate (key(n), dest(n), start(n_keys + 1))
+      allocate (dest(n), start(n_keys + 1))
       start = 0
       do p = 1, n
-         key(p) = (particles%material(p) - 1) * grid%cell_count + particles%cell(p)
-         start(key(p) + 1) = start(key(p) + 1) + 1
+         k = key(p)
+         start(k + 1) = start(k + 1) + 1
       end do
       ! start(k) = number of particles with a smaller key, then the running slot of key k
       start(1) = 0
@@ -45,13 +47,21 @@ contains
          start(m) = start(m) + start(m - 1)
       end do
       do p = 1, n
-         start(key(p)) = start(key(p)) + 1
-         dest(p) = start(key(p))
+         k = key(p)
+         start(k) = start(k) + 1
+         dest(p) = start(k)
       end do
 
-      call particles%reorder(dest, size(particles%mass))
+      call particles%permute(dest)
 
       call set_material_ranges(particles)
+
+   contains
+
+      pure integer function key(q)
+         integer, intent(in) :: q
+         key = (particles%material(q) - 1) * grid%cell_count + particles%cell(q)
+      end function key
    end subroutine sort_by_material_and_cell
 
    !> material_first(m):material_last(m) = the slice of material m (empty slice: first = 1, last = 0).

@@ -16,6 +16,7 @@
 !> written in the world frame.
 module body_motion
    use kinds, only: rp, i8, name_len
+   use communication_counters, only: count_collective, comm_records, real_bytes
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_SUM
    use scene_description, only: scene_t
    use material_model, only: material_slot_t
@@ -176,6 +177,7 @@ contains
          end associate
       end do
       call MPI_Allreduce(MPI_IN_PLACE, sums, size(sums), MPI_DOUBLE_PRECISION, MPI_SUM, comm)
+      call count_collective(comm_records, size(sums), real_bytes)
 
       do b = 1, nb
          associate (s => sums(:, b))

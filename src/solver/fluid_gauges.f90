@@ -17,6 +17,7 @@
 !> and the values are then 0. Collective: two reductions (sums, maxima) for all gauges together.
 module fluid_gauges
    use kinds, only: rp, name_len
+   use communication_counters, only: count_collective, comm_records, real_bytes
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_SUM, MPI_MAX
    use scene_description, only: scene_t, gauge_pressure, gauge_level, gauge_velocity
    use material_model, only: material_slot_t
@@ -175,7 +176,9 @@ contains
          end do
       end do
       call MPI_Allreduce(MPI_IN_PLACE, sums, size(sums), MPI_DOUBLE_PRECISION, MPI_SUM, comm)
+      call count_collective(comm_records, size(sums), real_bytes)
       if (self%n_max > 0) call MPI_Allreduce(MPI_IN_PLACE, maxima, size(maxima), MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+      if (self%n_max > 0) call count_collective(comm_records, size(maxima), real_bytes)
 
       do g = 1, size(self%gauges)
          associate (gauge => self%gauges(g))

@@ -16,6 +16,7 @@ module mpm_solver
                       MPI_INTEGER8
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use error_status, only: status_t
+   use communication_counters, only: count_collective, comm_time_step, comm_balance, comm_other, real_bytes, int8_bytes
    use scene_description, only: scene_t, run_control_t, wall_spec_t, model_newtonian_fluid
    use domain_decomposition, only: domain_t, layout_dims, fit_box, min_slab_width
    use shape_functions, only: shape_function_kind, ghost_node_layers
@@ -47,16 +48,21 @@ module mpm_solver
    use active_region, only: scene_extent, particle_extent, cells_of_extent, guard_cells, box_needs_change, target_box, &
                             slack_cells
    use status_broadcast, only: agree_on_status
+   use health_check, only: particles_healthy
    use input_text, only: int_text, real_text, group_context
    use phase_timers, only: phase_timers_t, phase_particles_to_grid, phase_grid_update, phase_walls, &
                            phase_stabilization, phase_grid_to_particles, phase_constitutive, phase_inflow, &
                            phase_halo, phase_migration, phase_sort, phase_time_step, phase_volume_correction, &
-                           phase_loads, phase_other
+                           phase_loads, phase_health, phase_other
    implicit none
    private
 
    !> Steps between full re-sorts of the particles when none arrived from another rank.
    integer, parameter :: sort_interval = 20
+
+   !> The time loop's flags that advance sets itself (solver_t%loop_flags): a particle is unhealthy
+   !> (health_check), the particle arrays could not grow. The caller's own flags follow them.
+   integer, parameter, public :: flag_unhealthy = 1, flag_no_memory = 2
 
    type, public :: solver_t
       type(scene_t) :: scene                    !< what the walls and inlets are rebuilt from
@@ -83,6 +89,12 @@ module mpm_solver
       real(rp), allocatable :: remapped_momentum(:, :)
       real(rp) :: extent(3, 2) = 0.0_rp         !< lowest and highest particle position after the last move
       integer :: relayouts = 0                  !< layouts made because the particles outgrew the active region
+      !> the time loop's flags, carried by the step's one reduction (follow_particles) instead of a reduction
+      !> of their own: the caller sets its flags (from index 3) before advance, advance sets flag_unhealthy
+      !> (with the limits below) and flag_no_memory and leaves the maxima over the ranks. Unallocated: none.
+      integer, allocatable :: loop_flags(:)
+      real(rp) :: speed_limit = 0.0_rp          !< blow-up limits of flag_unhealthy (particles_healthy)
+      real(rp) :: density_limits(2) = 0.0_rp
       type(phase_timers_t) :: timers            !< wall time per phase (the time loop adds its own phases)
    contains
       procedure :: init => solver_init
@@ -145,13 +157,16 @@ contains
       call self%bodies%init(scene, self%materials, frame, self%gravity)
       call self%contact%init(scene, self%bodies, size(self%materials))
 
-      call self%particles%init(scene%grid%dim, size(scene%materials), 1024, affine=scene%run%transfer == 'apic')
+      ! the spin only if some model reads it (the solids' Jaumann rate): a fluid scene holds none
+      call self%particles%init(scene%grid%dim, size(scene%materials), 1024, affine=scene%run%transfer == 'apic', &
+                               spin=any([(self%materials(i)%model%uses_spin, i = 1, size(self%materials))]))
       seed = .true.
       if (present(seed_particles)) seed = seed_particles
       if (seed) call seed_bodies(scene, self%grid, self%domain, self%particles)
       call self%check_particle_memory(status)
       if (.not. status%ok) return
       if (seed) call displace_fluid(self)
+      call self%particles%fit()
       if (seed) call check_structures_clear(self, status)
       if (.not. status%ok) return
       call update_cells(self%grid, self%particles)
@@ -166,6 +181,7 @@ contains
          min_mass = min(min_mass, self%inlets(i)%particle_mass)
       end do
       call MPI_Allreduce(MPI_IN_PLACE, min_mass, 1, MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
+      call count_collective(comm_other, 1, real_bytes)
       self%mass_tolerance = 1.0e-12_rp * min_mass
       self%time = 0.0_rp
       self%step = 0
@@ -286,6 +302,7 @@ contains
       integer :: cuts(0:self%domain%nranks, 3)
       if (self%domain%nranks == 1 .or. self%run%rebalance_threshold <= 0.0_rp) return
       call MPI_Allgather(int(self%particles%count, i8), 1, MPI_INTEGER8, counts, 1, MPI_INTEGER8, self%domain%comm)
+      call count_collective(comm_balance, self%domain%nranks, int8_bytes)
       if (real(maxval(counts), rp) * self%domain%nranks <= self%run%rebalance_threshold * real(sum(counts), rp)) return
       call balanced_layout(self%domain, self%grid, self%particles, cuts, largest)
       ! no better layout (particles packed in fewer layers than the ranks need): keep this one
@@ -339,6 +356,7 @@ contains
       call particle_extent(self%particles, extent(1:3), extent(4:6))
       extent(4:6) = -extent(4:6)
       call MPI_Allreduce(MPI_IN_PLACE, extent, 6, MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
+      call count_collective(comm_balance, 6, real_bytes)
       call needed_cells(self, extent(1:3), -extent(4:6), need_lo, need_hi)
       call target_box(need_lo, need_hi, guard_cells(1.0_rp) + slack_cells, self%grid%global_cells, dim, box_lo, box_hi)
       call fit_box(self%domain%dims, self%grid%global_cells, box_lo, box_hi, self%domain%min_width)
@@ -610,6 +628,7 @@ contains
       call local_speeds(self, speeds)
       speeds = -speeds
       call MPI_Allreduce(MPI_IN_PLACE, speeds, size(speeds), MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
+      call count_collective(comm_time_step, size(speeds), real_bytes)
       call time_step_of_speeds(self, -speeds, dt, speed)
    end function solver_stable_time_step
 
@@ -624,7 +643,7 @@ contains
       type(solver_t), intent(in) :: self
       real(rp), intent(out) :: speeds(:)
       integer :: m, first, last, p
-      real(rp) :: speed2
+      real(rp) :: speed2, rho_min
       speeds = 0.0_rp
       do m = 1, size(self%materials)
          first = self%particles%material_first(m)
@@ -633,11 +652,15 @@ contains
          if (self%run%fixed_dt > 0.0_rp) then
             speeds(2 * m) = sqrt(real(self%grid%dim, rp)) * maxval(abs(self%particles%v(:, first:last)))
          else
+            ! one pass over the particles for both (max and min are exact: the order does not matter); a NaN
+            ! density is passed over as minval does (the health check reports it)
             speed2 = 0.0_rp
+            rho_min = huge(1.0_rp)
             do p = first, last
                speed2 = max(speed2, sum(self%particles%v(:, p)**2))
+               if (self%particles%density(p) < rho_min) rho_min = self%particles%density(p)
             end do
-            speeds(2 * m - 1) = self%materials(m)%model%wave_speed(minval(self%particles%density(first:last)))
+            speeds(2 * m - 1) = self%materials(m)%model%wave_speed(rho_min)
             speeds(2 * m) = sqrt(speed2)
          end if
       end do
@@ -679,11 +702,13 @@ contains
 
    !> The next time step, and a new layout if the particles outgrew the active region or it became too big
    !> for them (active_region). One reduction for both: the step, the largest signal speed and the
-   !> particles' extent travel together (there is no other reduction per step for the box). Collective.
+   !> particles' extent travel together (there is no other reduction per step for the box), and with them
+   !> the time loop's flags (loop_flags). Collective.
    subroutine follow_particles(self)
       type(solver_t), intent(inout) :: self
-      real(rp) :: values(6 + 2 * size(self%materials)), speed
-      integer :: dim, need_lo(3), need_hi(3), box_lo(3), box_hi(3), target_lo(3), target_hi(3), guard, margin
+      real(rp), allocatable :: values(:)
+      real(rp) :: speed
+      integer :: dim, need_lo(3), need_hi(3), box_lo(3), box_hi(3), target_lo(3), target_hi(3), guard, margin, n, flags
       integer :: cuts(0:self%domain%nranks, 3)
       integer(i8) :: largest
       logical :: kept
@@ -693,15 +718,30 @@ contains
       ! all as minima: [lo(1:3), -hi(1:3), -speeds(:)] (local_speeds). The extent is that of the positions
       ! the step computed (no pass of its own): the safeguard then moves particles only back behind walls,
       ! by less than the step's travel, and inlets inject into their openings, which the region covers.
+      n = 6 + 2 * size(self%materials)
+      flags = 0
+      if (allocated(self%loop_flags)) flags = size(self%loop_flags)
+      allocate (values(n + flags))
       values(1:3) = self%extent(:, 1)
       values(4:6) = -self%extent(:, 2)
-      call local_speeds(self, values(7:))
-      values(7:) = -values(7:)
+      call local_speeds(self, values(7:n))
+      values(7:n) = -values(7:n)
+      if (flags > 0) then
+         call self%timers%switch_to(phase_health)
+         self%loop_flags(flag_unhealthy) = merge(0, 1, particles_healthy(self%particles, self%speed_limit, &
+                                                                         self%density_limits))
+         self%loop_flags(flag_no_memory) = merge(0, 1, self%particles%allocation%ok)
+         ! maxima as minima of the negated (small integers: exact)
+         values(n + 1:) = -real(self%loop_flags, rp)
+         call self%timers%switch_to(phase_time_step)
+      end if
       call MPI_Allreduce(MPI_IN_PLACE, values, size(values), MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
-      call time_step_of_speeds(self, -values(7:), self%dt, speed)
+      call count_collective(comm_time_step, size(values), real_bytes)
+      if (flags > 0) self%loop_flags = nint(-values(n + 1:))
+      call time_step_of_speeds(self, -values(7:n), self%dt, speed)
 
       ! a state that is no longer finite is the health check's business, not the layout's
-      if (.not. all(ieee_is_finite(values))) return
+      if (.not. all(ieee_is_finite(values(1:n)))) return
       call needed_cells(self, values(1:3), -values(4:6), need_lo, need_hi)
       guard = guard_cells(self%dt * speed * self%grid%inv_h)
       margin = guard + slack_cells

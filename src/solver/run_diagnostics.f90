@@ -1,6 +1,7 @@
 !> Global diagnostics of the run (one CSV row per output interval), reduced over all ranks.
 module run_diagnostics
    use kinds, only: rp, i8
+   use communication_counters, only: count_collective, comm_diagnostics, real_bytes, int8_bytes
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_INTEGER8, MPI_SUM, MPI_MAX
    use particle_set, only: particle_set_t
    use material_model, only: material_slot_t
@@ -51,6 +52,10 @@ contains
       call MPI_Allreduce(MPI_IN_PLACE, speed2, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
       call MPI_Allreduce(MPI_IN_PLACE, counts, 3, MPI_INTEGER8, MPI_SUM, comm)
       call MPI_Allreduce(int(particles%count, i8), largest, 1, MPI_INTEGER8, MPI_MAX, comm)
+      call count_collective(comm_diagnostics, 3, real_bytes)
+      call count_collective(comm_diagnostics, 1, real_bytes)
+      call count_collective(comm_diagnostics, 3, int8_bytes)
+      call count_collective(comm_diagnostics, 1, int8_bytes)
       diag%total_mass = sums(1)
       diag%kinetic_energy = sums(2)
       diag%fluid_volume = sums(3)

@@ -13,6 +13,7 @@
 !> safeguard); the structure's own entry keeps the total, the rest of which is the common field's.
 module wall_loads
    use kinds, only: rp, name_len
+   use communication_counters, only: count_collective, comm_records, real_bytes
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_SUM
    use scene_description, only: scene_t, wall_spec_t
    use boundary_walls, only: wall_t, impulse_rows, box_side_walls
@@ -136,8 +137,10 @@ contains
       integer :: e, at, d
       d = self%dim
       total = self%impulse
-      if (nranks > 1 .and. size(total) > 0) &
+      if (nranks > 1 .and. size(total) > 0) then
          call MPI_Allreduce(MPI_IN_PLACE, total, size(total), MPI_DOUBLE_PRECISION, MPI_SUM, comm)
+         call count_collective(comm_records, size(total), real_bytes)
+      end if
       allocate (values(size(self%names) * merge(3, 6, d == 2)))
       at = 0
       do e = 1, size(self%names)

@@ -33,6 +33,7 @@
 !> the migration of the step see them. Costs nothing without a fluid that selects it.
 module volume_correction
    use kinds, only: rp, i8
+   use communication_counters, only: count_collective, comm_volume, real_bytes
    use mpi_f08, only: MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_MAX
    use scene_description, only: scene_t, shifts_particles, relaxes_to_eos
    use domain_decomposition, only: domain_t
@@ -372,6 +373,7 @@ contains
       end do
       call MPI_Allreduce(MPI_IN_PLACE, self%surface_height, size(self%surface_height), MPI_DOUBLE_PRECISION, &
                          MPI_MAX, domain%comm)
+      call count_collective(comm_volume, size(self%surface_height), real_bytes)
    end subroutine measure_surface_heights
 
    !> fluid_volume(i) = int N_i over the open space below the height function, for the nodes whose support

@@ -84,9 +84,9 @@ contains
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
       real(rp), intent(in) :: flip_fraction
-      real(rp), intent(out) :: momentum(:, :)
+      real(rp), intent(out), contiguous :: momentum(:, :)
       integer, intent(in), optional :: field(:)
-      real(rp), intent(in), optional :: velocity(:, :), increment(:, :)
+      real(rp), intent(in), optional, contiguous :: velocity(:, :), increment(:, :)
       momentum = 0.0_rp
       if (present(field)) then
          select case (transfer_instance(grid, particles))
@@ -138,15 +138,16 @@ contains
       type(particle_set_t), intent(inout) :: particles
       real(rp), intent(in) :: dt, flip_fraction, theta
       logical, intent(in) :: update_velocity, compute_strain, update_position
-      real(rp), intent(in), optional :: strain_velocity(:, :)
+      real(rp), intent(in), optional, contiguous :: strain_velocity(:, :)
       logical, intent(in), optional :: compute_spin
       real(rp), intent(out), optional :: extent(3, 2)
       integer, intent(in), optional :: field(:)
-      real(rp), intent(in), optional :: velocity(:, :), increment(:, :)
+      real(rp), intent(in), optional, contiguous :: velocity(:, :), increment(:, :)
       real(rp) :: lo(3), hi(3)
       logical :: spin
       spin = compute_strain
       if (present(compute_spin)) spin = compute_strain .and. compute_spin
+      spin = spin .and. particles%n_spin > 0       ! a set without spin (no model reads it)
       lo = 0.0_rp
       hi = 0.0_rp
       if (present(field)) then

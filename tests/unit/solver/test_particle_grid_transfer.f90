@@ -103,6 +103,11 @@ contains
       real(rp) :: x(2)
       integer :: i, p, rest, g(2)
       call make_solver(comm, 2, solver)
+      ! water: no model reads the spin, so the set holds none; give it room to check G2P's w_p
+      call assertEqual(0, solver%particles%n_spin, 'a water scene holds no spin')
+      deallocate (solver%particles%spin)
+      solver%particles%n_spin = 1
+      allocate (solver%particles%spin(1, size(solver%particles%mass)))
       do i = 1, solver%grid%node_count
          rest = i - 1
          g(1) = solver%grid%node_lo(1) + mod(rest, solver%grid%n_nodes(1))
