@@ -409,6 +409,8 @@ contains
          smoothed(m) = allocated(self%schemes(m)%scheme)
          if (smoothed(m)) smoothed(m) = material_supplied(self, m)
       end do
+      ! only one material supplied: all particles are its particles, on every rank
+      context%sole_material = count([(material_supplied(self, m), m = 1, size(self%materials))]) == 1
       ! the spin only for the solids (local: the stress update is)
       spin_needed = .false.
       do m = 1, size(self%materials)

@@ -6,20 +6,27 @@
 !> are stored by `prepare`, before the particles move). Nodal sums use the solver's ghost-node sum. N_ip are
 !> the grid's shape functions, multilinear or quadratic B-spline (the projection onto the nodes is the same
 !> lumped L2 projection whatever the stencil; docs/theory.md section 1.1).
+!>
+!> Cost (docs/performance.md, "NB"): the particle loops are node_based_kernels' compile-time instances;
+!> the work arrays are kept from step to step (they only grow); and when the material's particles are
+!> all the particles (context%sole_material) m_i is the grid's mass row of the step's P2G, the same sum
+!> in the same order, so `prepare` neither sums nor exchanges the masses again.
 module node_based_anti_locking
    use kinds, only: rp
    use particle_set, only: particle_set_t
    use stabilizer, only: stabilizer_t, stage_context_t
-   use shape_functions, only: stencil_base, stencil_values
-   use background_grid, only: grid_t
+   use background_grid, only: grid_t, row_mass
    use node_halo, only: sum_shared_nodes
+   use node_based_kernels, only: store_shape_values, scatter_to_nodes, gather_from_nodes
    implicit none
    private
 
    type, extends(stabilizer_t), public :: node_based_anti_locking_t
       integer, allocatable :: base(:)            !< base node of each particle's stencil (slice order)
       real(rp), allocatable :: weight(:, :)      !< N_a(x_p^n) of the stencil's nodes (slice order)
-      real(rp), allocatable :: nodal_mass(:)     !< m_i of this material, summed over ranks
+      real(rp), allocatable :: nodal_mass(:, :)  !< m_i of this material, summed over ranks (1, node; if own_mass)
+      real(rp), allocatable :: nodal(:, :)       !< the projected values (components, node)
+      logical :: own_mass = .true.               !< m_i is nodal_mass, else the grid's mass row
    contains
       procedure :: prepare => nb_prepare
       procedure :: filter_strain_rate => nb_filter_strain_rate
@@ -33,36 +40,29 @@ contains
       class(node_based_anti_locking_t), intent(inout) :: self
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
-      real(rp) :: xi(3)
-      integer :: p, q, a, c(3), first, last, dim, k
-      real(rp), allocatable :: mass(:, :), gradients(:, :)
+      integer :: n
 
       associate (grid => context%grid)
-         dim = grid%dim
-         first = context%first
-         last = context%last
-         if (allocated(self%base)) deallocate (self%base, self%weight)
-         allocate (self%base(max(0, last - first + 1)), self%weight(grid%stencil_size, max(0, last - first + 1)))
-         allocate (mass(1, grid%node_count), gradients(dim, grid%stencil_size))
-         mass = 0.0_rp
-         do p = first, last
-            q = p - first + 1
-            xi(1:dim) = (particles%x(:, p) - grid%origin(1:dim)) * grid%inv_h
-            c = 0
-            do k = 1, dim
-               c(k) = stencil_base(grid%shape, xi(k), grid%global_cells(k))
-            end do
-            self%base(q) = grid%local_node(c)
-            xi(1:dim) = xi(1:dim) - c(1:dim)
-            call stencil_values(grid%shape, dim, xi(1:dim), grid%inv_h, self%weight(:, q), gradients)
-            do a = 1, grid%stencil_size
-               associate (node => self%base(q) + grid%stencil_stride(a))
-                  mass(1, node) = mass(1, node) + self%weight(a, q) * particles%mass(p)
-               end associate
-            end do
-         end do
-         call sum_shared_nodes(context%domain, grid, mass)
-         self%nodal_mass = mass(1, :)
+         n = max(0, context%last - context%first + 1)
+         if (allocated(self%base)) then
+            if (size(self%base) < n .or. size(self%weight, 1) /= grid%stencil_size) deallocate (self%base, self%weight)
+         end if
+         if (.not. allocated(self%base)) allocate (self%base(n), self%weight(grid%stencil_size, n))
+         self%own_mass = .not. context%sole_material
+         if (self%own_mass) then
+            if (allocated(self%nodal_mass)) then
+               if (size(self%nodal_mass, 2) < grid%node_count) deallocate (self%nodal_mass)
+            end if
+            if (.not. allocated(self%nodal_mass)) allocate (self%nodal_mass(1, grid%node_count))
+            associate (mass => self%nodal_mass(:, 1:grid%node_count))
+               mass = 0.0_rp
+               call store_shape_values(grid, particles, context%first, context%last, self%base, self%weight, &
+                                       mass(1, :))
+               call sum_shared_nodes(context%domain, grid, mass)
+            end associate
+         else
+            call store_shape_values(grid, particles, context%first, context%last, self%base, self%weight)
+         end if
       end associate
    end subroutine nb_prepare
 
@@ -83,33 +83,39 @@ contains
    !> values(:, q) := sum_i N_iq (sum_r N_ir m_r values_r / m_i) for the material's slice (values(:, q)
    !> belongs to particle context%first + q - 1). Collective.
    subroutine project_and_interpolate(self, context, particles, values)
-      type(node_based_anti_locking_t), intent(in) :: self
+      type(node_based_anti_locking_t), intent(inout) :: self
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(in) :: particles
-      real(rp), intent(inout) :: values(:, :)
-      real(rp), allocatable :: nodal(:, :)
-      integer :: q, a, node, i
+      real(rp), intent(inout), contiguous :: values(:, :)
+      integer :: nodes
       type(grid_t), pointer :: grid
 
       grid => context%grid
-      allocate (nodal(size(values, 1), grid%node_count))
-      nodal = 0.0_rp
-      do q = 1, size(values, 2)
-         do a = 1, grid%stencil_size
-            node = self%base(q) + grid%stencil_stride(a)
-            nodal(:, node) = nodal(:, node) + self%weight(a, q) * particles%mass(context%first + q - 1) * values(:, q)
-         end do
-      end do
-      call sum_shared_nodes(context%domain, grid, nodal)
-      do i = 1, grid%node_count
-         if (self%nodal_mass(i) > 0.0_rp) nodal(:, i) = nodal(:, i) / self%nodal_mass(i)
-      end do
-      do q = 1, size(values, 2)
-         values(:, q) = 0.0_rp
-         do a = 1, grid%stencil_size
-            node = self%base(q) + grid%stencil_stride(a)
-            values(:, q) = values(:, q) + self%weight(a, q) * nodal(:, node)
-         end do
-      end do
+      nodes = grid%node_count
+      if (allocated(self%nodal)) then
+         if (size(self%nodal, 1) /= size(values, 1) .or. size(self%nodal, 2) < nodes) deallocate (self%nodal)
+      end if
+      if (.not. allocated(self%nodal)) allocate (self%nodal(size(values, 1), nodes))
+      associate (nodal => self%nodal(:, 1:nodes))
+         nodal = 0.0_rp
+         call scatter_to_nodes(grid, self%base, self%weight, particles%mass(context%first:context%last), values, nodal)
+         call sum_shared_nodes(context%domain, grid, nodal)
+         if (self%own_mass) then
+            call divide(nodal, self%nodal_mass(1, 1:nodes))
+         else
+            call divide(nodal, grid%accumulated(row_mass, 1:nodes))
+         end if
+         call gather_from_nodes(grid, self%base, self%weight, nodal, values)
+      end associate
    end subroutine project_and_interpolate
+
+   !> nodal(:, i) := nodal(:, i) / mass(i) where the material has mass.
+   subroutine divide(nodal, mass)
+      real(rp), intent(inout), contiguous :: nodal(:, :)
+      real(rp), intent(in) :: mass(:)
+      integer :: i
+      do i = 1, size(mass)
+         if (mass(i) > 0.0_rp) nodal(:, i) = nodal(:, i) / mass(i)
+      end do
+   end subroutine divide
 end module node_based_anti_locking

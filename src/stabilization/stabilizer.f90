@@ -20,6 +20,9 @@ module stabilizer
       type(domain_t), pointer :: domain => null()
       type(grid_t), pointer :: grid => null()
       real(rp) :: dt = 0.0_rp
+      !> the material is the only one with particles, on every rank: the grid's mass row of the step's P2G
+      !> is its nodal mass (NB uses it)
+      logical :: sole_material = .false.
    end type stage_context_t
 
    type, abstract, public :: stabilizer_t

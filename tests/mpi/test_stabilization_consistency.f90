@@ -2,7 +2,9 @@
 !>  - FOAL1 smoothing of a random field and of a checkerboard gives the same particle values on one
 !>    rank and on all ranks of `comm` (<= 1e-13 relative): the cell halo carries what the fluxes need;
 !>  - FOAL1 with gamma_max = 0 is C0, bit for bit;
-!>  - C0 in 2-D is one-point quadrature at the cell mass centre (algorithms.md section 2.2).
+!>  - C0 in 2-D is one-point quadrature at the cell mass centre (algorithms.md section 2.2);
+!>  - NB of the only material takes the grid's mass row of P2G for its own nodal masses, bit for bit;
+!>  - FOAL1 and NB of two materials keep each material's sum m_p s_p.
 module test_stabilization_consistency
    use kinds, only: rp, i8
    use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_split, MPI_Comm_free, MPI_Allreduce, MPI_Bcast, &
@@ -13,7 +15,8 @@ module test_stabilization_consistency
    use mpm_solver, only: solver_t
    use run_diagnostics, only: diagnostics_t
    use stabilizer, only: stage_context_t
-   use grid_transfer, only: grid_to_particles
+   use grid_transfer, only: grid_to_particles, particles_to_grid
+   use node_halo, only: sum_shared_nodes
    use shape_functions, only: n_corners, corner_offset, shape_values_and_gradients
    use test_scenes, only: water_scene, add_body
    implicit none
@@ -22,7 +25,7 @@ module test_stabilization_consistency
    public :: test_c0_volumetric_only, &
              test_conservation_per_material, test_random_field_rank_invariance, test_checkerboard_rank_invariance, &
              test_random_field_3d_rank_invariance, &
-             test_gamma_zero_is_c0, test_c0_is_one_point_quadrature_2d
+             test_gamma_zero_is_c0, test_c0_is_one_point_quadrature_2d, test_nb_sole_material_grid_mass
 
    integer, parameter :: random_field = 1, checkerboard = 2
 
@@ -135,16 +138,24 @@ contains
       call solver%free()
    end subroutine smoothed_field
 
-   !> Two fluids side by side and mixed in some cells, each smoothed by its own FOAL1: the sum of m_p s_p
-   !> of each material is unchanged by the stress stage (cell averaging and fluxes), to round-off.
+   !> Two fluids side by side and mixed in some cells, each smoothed by its own FOAL1, then by its own NB:
+   !> the sum of m_p s_p of each material is unchanged by the stress stage (cell averaging and fluxes;
+   !> NB's projection with the material's own nodal masses), to round-off.
    subroutine test_conservation_per_material(comm)
       type(MPI_Comm), intent(in) :: comm
+      call conservation_per_material(comm, 'FOAL1')
+      call conservation_per_material(comm, 'NB')
+   end subroutine test_conservation_per_material
+
+   subroutine conservation_per_material(comm, scheme)
+      type(MPI_Comm), intent(in) :: comm
+      character(len=*), intent(in) :: scheme
       type(solver_t), target :: solver
       type(scene_t) :: scene
       type(status_t) :: status
       real(rp) :: before(6, 2), after(6, 2), scale(2)
       integer :: m, p
-      scene = block_scene(2, 'FOAL1')
+      scene = block_scene(2, scheme)
       scene%materials = [scene%materials(1), scene%materials(1)]
       scene%materials(2)%name = 'oil'
       scene%materials(2)%density = 800.0_rp
@@ -167,7 +178,73 @@ contains
          call assertTrue(maxval(abs(after(5:6, m) - before(5:6, m))) < scale(m), 'scale unchanged')
       end do
       call solver%free()
-   end subroutine test_conservation_per_material
+   end subroutine conservation_per_material
+
+   !> NB of a material that has all the particles (context%sole_material, as the solver sets it) takes
+   !> m_i from the grid's mass row of P2G instead of its own sum: the filtered stresses and strain rates
+   !> are bitwise those of its own sum, on any number of ranks, in 2-D and 3-D and with both stencils.
+   subroutine test_nb_sole_material_grid_mass(comm)
+      type(MPI_Comm), intent(in) :: comm
+      call nb_sole_material(comm, 2, 'linear')
+      call nb_sole_material(comm, 2, 'bspline2')
+      call nb_sole_material(comm, 3, 'linear')
+   end subroutine test_nb_sole_material_grid_mass
+
+   subroutine nb_sole_material(comm, dim, shape)
+      type(MPI_Comm), intent(in) :: comm
+      integer, intent(in) :: dim
+      character(len=*), intent(in) :: shape
+      type(solver_t), target :: solver
+      type(scene_t) :: scene
+      type(status_t) :: status
+      type(stage_context_t) :: context
+      real(rp), allocatable :: s0(:, :), d0(:, :), s_own(:, :), d_own(:, :)
+      integer :: p, n, step
+      logical :: sole
+      scene = block_scene(dim, 'NB')
+      scene%grid%shape_function = shape
+      scene%bodies(1)%hydrostatic = .false.
+      call solver%init(scene, comm, status)
+      call assertTrue(status%ok, 'solver init: '//trim(status%message))
+      do step = 1, 5          ! a moving block: particles off the lattice
+         call solver%advance()
+      end do
+      n = solver%particles%count
+      do p = 1, n
+         solver%particles%sbar(:, p) = value_of(solver%particles%id(p), [0, 0, 0], random_field, &
+                                                solver%particles%n_sigma)
+         solver%particles%strain_rate(:, p) = value_of(solver%particles%id(p) + 77, [0, 0, 0], random_field, &
+                                                       solver%particles%n_sigma)
+      end do
+      s0 = solver%particles%sbar(:, 1:n)
+      d0 = solver%particles%strain_rate(:, 1:n)
+      ! the grid's rows of the current positions, as the step's P2G leaves them
+      call particles_to_grid(solver%grid, solver%particles, solver%gravity)
+      call sum_shared_nodes(solver%domain, solver%grid, solver%grid%accumulated)
+      context%domain => solver%domain
+      context%grid => solver%grid
+      context%first = solver%particles%material_first(1)
+      context%last = solver%particles%material_last(1)
+      do step = 1, 2
+         sole = step == 2
+         context%sole_material = sole
+         solver%particles%sbar(:, 1:n) = s0
+         solver%particles%strain_rate(:, 1:n) = d0
+         call solver%schemes(1)%scheme%prepare(context, solver%particles)
+         call solver%schemes(1)%scheme%filter_strain_rate(context, solver%particles)
+         call solver%schemes(1)%scheme%filter_stress(context, solver%particles)
+         if (.not. sole) then
+            s_own = solver%particles%sbar(:, 1:n)
+            d_own = solver%particles%strain_rate(:, 1:n)
+         end if
+      end do
+      call assertTrue(maxval(abs(s_own - s0)) > 0.0_rp, 'NB smoothed the stress')
+      call assertEqual(0.0_rp, maxval(abs(solver%particles%sbar(:, 1:n) - s_own)), 0.0_rp, &
+                       'grid mass row: stresses bitwise equal ('//shape//')')
+      call assertEqual(0.0_rp, maxval(abs(solver%particles%strain_rate(:, 1:n) - d_own)), 0.0_rp, &
+                       'grid mass row: strain rates bitwise equal ('//shape//')')
+      call solver%free()
+   end subroutine nb_sole_material
 
    !> C0 with volumetric_only: the mean normal stress becomes its cell's mass-weighted mean (so the sum of
    !> m_p times it is kept), and every particle keeps its deviatoric stress.
