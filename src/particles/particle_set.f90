@@ -208,8 +208,8 @@ contains
             dest(p) = -q
             call swap_real(self%x(:, q), x(1:d))
             call swap_real(self%v(:, q), v(1:d))
-            call swap_real1(self%mass(q), mass)
-            call swap_real1(self%density(q), density)
+            call swap_real(self%mass(q), mass)
+            call swap_real(self%density(q), density)
             call swap_real(self%sbar(:, q), sbar(1:s))
             call swap_real(self%affine(:, q), affine(1:a))
             call swap_int(self%material(q), material)
@@ -222,21 +222,14 @@ contains
       dest = abs(dest)
    end subroutine particles_permute
 
-   pure subroutine swap_real(slot, held)
-      real(rp), intent(inout) :: slot(:), held(:)
-      real(rp) :: t(size(slot))
-      t = slot
-      slot = held
-      held = t
-   end subroutine swap_real
-
-   pure subroutine swap_real1(slot, held)
+   !> Elemental: one particle's scalar field or, element by element, its columns.
+   elemental subroutine swap_real(slot, held)
       real(rp), intent(inout) :: slot, held
       real(rp) :: t
       t = slot
       slot = held
       held = t
-   end subroutine swap_real1
+   end subroutine swap_real
 
    pure subroutine swap_int(slot, held)
       integer, intent(inout) :: slot, held

@@ -77,29 +77,17 @@ contains
 #define GATHER gather_2d
 #include "../grid/multilinear_shape.inc"
 #include "node_based_kernels.inc"
-#undef KERNEL_DIM
-#undef N_SIGMA
-#undef SHAPE
-#undef STORE
-#undef SCATTER
-#undef GATHER
 
 #define KERNEL_DIM 3
 #define N_SIGMA 6
+#define WIDTH 2
 #define SHAPE shape_3d
+#define BASE base_linear
 #define STORE store_3d
 #define SCATTER scatter_3d
 #define GATHER gather_3d
 #include "../grid/multilinear_shape.inc"
 #include "node_based_kernels.inc"
-#undef KERNEL_DIM
-#undef N_SIGMA
-#undef WIDTH
-#undef SHAPE
-#undef BASE
-#undef STORE
-#undef SCATTER
-#undef GATHER
 
 #define KERNEL_DIM 2
 #define N_SIGMA 4
@@ -111,16 +99,12 @@ contains
 #define GATHER gather_b2_2d
 #include "../grid/bspline2_shape.inc"
 #include "node_based_kernels.inc"
-#undef KERNEL_DIM
-#undef N_SIGMA
-#undef SHAPE
-#undef STORE
-#undef SCATTER
-#undef GATHER
 
 #define KERNEL_DIM 3
 #define N_SIGMA 6
+#define WIDTH 3
 #define SHAPE bspline2_3d
+#define BASE base_bspline2
 #define STORE store_b2_3d
 #define SCATTER scatter_b2_3d
 #define GATHER gather_b2_3d
