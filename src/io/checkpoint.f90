@@ -418,7 +418,8 @@ contains
          if (.not. status%ok) return
       end if
       call solver%particles%init(scene%grid%dim, size(scene%materials), max(state%n, 1024), &
-                                 affine=size(state%affine, 1) > 0, spin=solver%particles%n_spin > 0)
+                                 affine=size(state%affine, 1) > 0, spin=solver%particles%n_spin > 0, &
+                                 strain_rate=solver%particles%n_rate > 0)
       do p = 1, state%n
          call solver%particles%add(state%x(:, p), state%v(:, p), state%mass(p), state%density(p), state%sbar(:, p), &
                                    state%material(p), state%id(p), state%affine(:, p))

@@ -23,6 +23,7 @@ module particle_set
    type, public :: particle_set_t
       integer :: dim = 2, n_sigma = 4, n_materials = 1
       integer :: n_spin = 1                         !< spin components, 0 when no model reads the spin
+      integer :: n_rate = 4                         !< rows of strain_rate: n_sigma, or 0 when not stored
       integer :: n_affine = 0                       !< dim**2 with APIC, else 0
       integer :: count = 0                          !< particles held
       real(rp), allocatable :: x(:, :)              !< position (dim, p), grid frame [m]
@@ -35,7 +36,8 @@ module particle_set
       integer, allocatable :: material(:)           !< material index
       integer(i8), allocatable :: id(:)             !< globally unique id
       integer, allocatable :: cell(:)               !< local cell index at x^n (set by the sort)
-      real(rp), allocatable :: strain_rate(:, :)    !< d_p, replaced by d~_p when filtered (n_sigma, p)
+      !> d_p, replaced by d~_p when filtered (n_rate, p): kept only when a scheme filters it
+      real(rp), allocatable :: strain_rate(:, :)
       real(rp), allocatable :: spin(:, :)           !< w_p components (n_spin, p)
       integer, allocatable :: material_first(:), material_last(:)
       type(status_t) :: allocation                  !< failed if the arrays could not grow
@@ -54,17 +56,23 @@ module particle_set
 
 contains
 
-   !> An empty set; `affine` (default .false.): carry APIC's affine matrix per particle; `spin` (default
-   !> .true.): hold the spin (only a model with uses_spin reads it).
-   subroutine particles_init(self, dim, n_materials, capacity, affine, spin)
+   !> An empty set; `affine` (default .false.): carry APIC's affine matrix per particle; `spin` and
+   !> `strain_rate` (default .true.): hold the spin and the rate of deformation between the steps'
+   !> stages (only a scheme that filters the rate, and a model with uses_spin behind one, need them: the
+   !> solver's fused stage keeps both in a block buffer otherwise).
+   subroutine particles_init(self, dim, n_materials, capacity, affine, spin, strain_rate)
       class(particle_set_t), intent(inout) :: self
       integer, intent(in) :: dim, n_materials, capacity
-      logical, intent(in), optional :: affine, spin
+      logical, intent(in), optional :: affine, spin, strain_rate
       self%dim = dim
       self%n_sigma = n_components(dim)
       self%n_spin = n_spin(dim)
       if (present(spin)) then
          if (.not. spin) self%n_spin = 0
+      end if
+      self%n_rate = self%n_sigma
+      if (present(strain_rate)) then
+         if (.not. strain_rate) self%n_rate = 0
       end if
       self%n_affine = 0
       if (present(affine)) then
@@ -87,14 +95,14 @@ contains
       integer :: stat
       allocate (self%x(self%dim, capacity), self%v(self%dim, capacity), self%mass(capacity), &
                 self%density(capacity), self%sbar(self%n_sigma, capacity), self%material(capacity), &
-                self%id(capacity), self%cell(capacity), self%strain_rate(self%n_sigma, capacity), &
+                self%id(capacity), self%cell(capacity), self%strain_rate(self%n_rate, capacity), &
                 self%spin(self%n_spin, capacity), self%affine(self%n_affine, capacity), stat=stat)
       if (stat == 0) return
       call no_memory(self, capacity)
       ! an empty set, so that the caller can still report and stop
       call free_arrays(self)
       allocate (self%x(self%dim, 0), self%v(self%dim, 0), self%mass(0), self%density(0), self%sbar(self%n_sigma, 0), &
-                self%material(0), self%id(0), self%cell(0), self%strain_rate(self%n_sigma, 0), self%spin(self%n_spin, 0), &
+                self%material(0), self%id(0), self%cell(0), self%strain_rate(self%n_rate, 0), self%spin(self%n_spin, 0), &
                 self%affine(self%n_affine, 0))
    end subroutine allocate_arrays
 
@@ -110,7 +118,7 @@ contains
    !> Bytes of the particle arrays per particle.
    pure integer(i8) function particle_bytes(self)
       type(particle_set_t), intent(in) :: self
-      particle_bytes = 8_i8 * (2 * self%dim + 2 + 2 * self%n_sigma + self%n_spin + self%n_affine + 1) + 4_i8 * 2
+      particle_bytes = 8_i8 * (2 * self%dim + 2 + self%n_sigma + self%n_rate + self%n_spin + self%n_affine + 1) + 4_i8 * 2
    end function particle_bytes
 
    subroutine free_arrays(self)
@@ -166,11 +174,11 @@ contains
       if (ok) ok = resize_i8(self%id, n, capacity)
       if (ok .and. capacity /= size(self%strain_rate, 2)) then
          deallocate (self%strain_rate, self%spin)
-         allocate (self%strain_rate(self%n_sigma, capacity), self%spin(self%n_spin, capacity), stat=stat)
+         allocate (self%strain_rate(self%n_rate, capacity), self%spin(self%n_spin, capacity), stat=stat)
          if (stat /= 0) then
             if (allocated(self%strain_rate)) deallocate (self%strain_rate)
             if (allocated(self%spin)) deallocate (self%spin)
-            allocate (self%strain_rate(self%n_sigma, 0), self%spin(self%n_spin, 0))
+            allocate (self%strain_rate(self%n_rate, 0), self%spin(self%n_spin, 0))
             ok = .false.
          end if
       end if

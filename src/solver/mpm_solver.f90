@@ -25,6 +25,7 @@ module mpm_solver
    use background_grid, only: grid_t, row_mass
    use node_halo, only: sum_shared_nodes
    use particle_set, only: particle_set_t
+   use tensor_layout, only: n_spin
    use particle_seeding, only: seed_bodies
    use body_lattice, only: scene_id_count
    use particle_sorting, only: sort_by_material_and_cell, update_cells, set_material_ranges
@@ -122,6 +123,7 @@ contains
       real(rp) :: min_mass
       type(frame_t) :: frame
       logical :: seed
+      logical, allocatable :: filtered(:)
       integer :: dim, grid_cells(3), i, need_lo(3), need_hi(3), box_lo(3), box_hi(3)
       real(rp) :: grid_origin(3), x_lo(3), x_hi(3)
 
@@ -157,9 +159,13 @@ contains
       call self%bodies%init(scene, self%materials, frame, self%gravity)
       call self%contact%init(scene, self%bodies, size(self%materials))
 
-      ! the spin only if some model reads it (the solids' Jaumann rate): a fluid scene holds none
+      ! the rate of deformation and the spin are held per particle only for a material with a scheme, which
+      ! filters the rate between G2P and the stress update (the spin only if such a model reads it: the
+      ! solids' Jaumann rate); the others' stay in move_particles' block buffer
+      filtered = [(allocated(self%schemes(i)%scheme), i = 1, size(self%materials))]
       call self%particles%init(scene%grid%dim, size(scene%materials), 1024, affine=scene%run%transfer == 'apic', &
-                               spin=any([(self%materials(i)%model%uses_spin, i = 1, size(self%materials))]))
+                               spin=any([(self%materials(i)%model%uses_spin .and. filtered(i), &
+                                          i = 1, size(self%materials))]), strain_rate=any(filtered))
       seed = .true.
       if (present(seed_particles)) seed = seed_particles
       if (seed) call seed_bodies(scene, self%grid, self%domain, self%particles)
@@ -390,7 +396,7 @@ contains
       integer :: m, first, last, arrived, created, i
       real(rp) :: dt
       type(stage_context_t) :: context
-      logical :: smoothed(size(self%schemes)), spin_needed
+      logical :: smoothed(size(self%schemes))
 
       dt = self%dt
       call self%timers%switch_to(phase_walls)
@@ -411,12 +417,6 @@ contains
       end do
       ! only one material supplied: all particles are its particles, on every rank
       context%sole_material = count([(material_supplied(self, m), m = 1, size(self%materials))]) == 1
-      ! the spin only for the solids (local: the stress update is)
-      spin_needed = .false.
-      do m = 1, size(self%materials)
-         if (self%materials(m)%model%uses_spin .and. self%particles%material_last(m) >= self%particles%material_first(m)) &
-            spin_needed = .true.
-      end do
       call self%timers%switch_to(phase_particles_to_grid)
       if (self%contact%active) then
          call self%contact%assign_fields(self%particles)
@@ -438,33 +438,9 @@ contains
       end do
 
       call self%timers%switch_to(phase_grid_to_particles)
-      associate (run => self%run, contact => self%contact)
-         if (contact%active .and. self%musl) then
-            call remap_velocities(self)
-            call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
-                                   update_velocity=.false., compute_strain=.true., update_position=.true., &
-                                   strain_velocity=contact%remapped, compute_spin=spin_needed, extent=self%extent, &
-                                   field=contact%particle_field, velocity=contact%velocity, increment=contact%increment)
-         else if (contact%active) then
-            call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
-                                   update_velocity=.true., compute_strain=.true., update_position=.true., &
-                                   compute_spin=spin_needed, extent=self%extent, field=contact%particle_field, &
-                                   velocity=contact%velocity, increment=contact%increment)
-         else if (self%musl) then
-            call remap_velocities(self)
-            call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
-                                   update_velocity=.false., compute_strain=.true., update_position=.true., &
-                                   strain_velocity=self%remapped_momentum, compute_spin=spin_needed, &
-                                   extent=self%extent)
-         else
-            call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
-                                   update_velocity=.true., compute_strain=.true., update_position=.true., &
-                                   compute_spin=spin_needed, extent=self%extent)
-         end if
-      end associate
+      if (self%musl) call remap_velocities(self)
+      call move_particles(self, dt)
       if (self%volume%shifting_now) then
-         call self%timers%switch_to(phase_volume_correction)
-         call self%volume%apply_shifts(self%particles)
          ! the shifts come after the extent was taken: widen it by their largest length
          self%extent(:, 1) = self%extent(:, 1) - max_shift_in_cells * self%grid%h
          self%extent(:, 2) = self%extent(:, 2) + max_shift_in_cells * self%grid%h
@@ -476,11 +452,12 @@ contains
          call set_slice(m)
          call self%schemes(m)%scheme%filter_strain_rate(context, self%particles)
       end do
+      ! the stress update of the filtered materials (the others had theirs in move_particles)
       call self%timers%switch_to(phase_constitutive)
       do m = 1, size(self%materials)
          first = self%particles%material_first(m)
          last = self%particles%material_last(m)
-         if (last < first) cycle
+         if (last < first .or. .not. allocated(self%schemes(m)%scheme)) cycle
          call self%materials(m)%model%update_stress(self%grid%dim, dt, self%particles%strain_rate(:, first:last), &
                                                    self%particles%spin(:, first:last), &
                                                    self%particles%density(first:last), self%particles%sbar(:, first:last))
@@ -619,6 +596,90 @@ contains
       call apply_wall_constraints(self%walls, self%grid%dim, self%remapped_momentum)
       call self%timers%switch_to(phase_grid_to_particles)
    end subroutine remap_velocities
+
+   !> Step 7 (G2P: rate of deformation, velocities with USL, positions), the volume correction's shifts,
+   !> and step 5's stress update for the materials no scheme filters, material by material. The stress
+   !> update of an unfiltered material follows G2P block by block, so that the block's rate of
+   !> deformation is still in cache and no particle array holds it (docs/performance.md, "Memory per
+   !> particle"); each particle still gets G2P, its shift and its stress update in this order, so the
+   !> results are those of three passes bit for bit. A filtered material's rate goes to
+   !> particles%strain_rate for its scheme, and its stress update comes after the filter. self%extent
+   !> gets the extent of the new positions.
+   subroutine move_particles(self, dt)
+      class(solver_t), intent(inout), target :: self
+      real(rp), intent(in) :: dt
+      integer, parameter :: block_size = 256    ! 8 (2-D) to 12 kB (3-D) of rate: stays in L1
+      real(rp) :: rate(self%particles%n_sigma, block_size), extent(3, 2)
+      real(rp), allocatable :: spin(:, :)
+      integer :: m, first, last, b, e, dim, covered
+      logical :: uses_spin
+
+      dim = self%grid%dim
+      self%extent(:, 1) = 0.0_rp
+      self%extent(:, 2) = 0.0_rp
+      self%extent(1:dim, 1) = huge(1.0_rp)
+      self%extent(1:dim, 2) = -huge(1.0_rp)
+      covered = 0
+      do m = 1, size(self%materials)
+         first = self%particles%material_first(m)
+         last = self%particles%material_last(m)
+         if (last < first) cycle
+         covered = covered + last - first + 1
+         uses_spin = self%materials(m)%model%uses_spin
+         if (allocated(self%schemes(m)%scheme)) then
+            call particle_kinematics(first, last, self%particles%strain_rate(:, first:last), &
+                                     self%particles%spin(:, first:last))
+            if (self%volume%shifting_now) call self%volume%apply_shifts(self%particles, first, last)
+         else
+            allocate (spin(merge(n_spin(dim), 0, uses_spin), block_size))
+            do b = first, last, block_size
+               e = min(last, b + block_size - 1)
+               call particle_kinematics(b, e, rate(:, 1:e - b + 1), spin(:, 1:e - b + 1))
+               if (self%volume%shifting_now) call self%volume%apply_shifts(self%particles, b, e)
+               call self%materials(m)%model%update_stress(dim, dt, rate(:, 1:e - b + 1), spin(:, 1:e - b + 1), &
+                                                         self%particles%density(b:e), self%particles%sbar(:, b:e))
+            end do
+            deallocate (spin)
+         end if
+      end do
+      ! the material slices are contiguous and cover the set (sorted by material after every arrival)
+      if (covered /= self%particles%count) error stop 'move_particles: the material slices do not cover the particles'
+
+   contains
+
+      !> G2P of particles first:last, their rate and spin into d and w.
+      subroutine particle_kinematics(first, last, d, w)
+         integer, intent(in) :: first, last
+         real(rp), intent(inout), contiguous :: d(:, :), w(:, :)
+         associate (run => self%run, contact => self%contact)
+            if (contact%active .and. self%musl) then
+               call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
+                                      update_velocity=.false., compute_strain=.true., update_position=.true., &
+                                      strain_velocity=contact%remapped, compute_spin=uses_spin, extent=extent, &
+                                      field=contact%particle_field, velocity=contact%velocity, &
+                                      increment=contact%increment, first=first, last=last, strain_rate=d, spin=w)
+            else if (contact%active) then
+               call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
+                                      update_velocity=.true., compute_strain=.true., update_position=.true., &
+                                      compute_spin=uses_spin, extent=extent, field=contact%particle_field, &
+                                      velocity=contact%velocity, increment=contact%increment, first=first, &
+                                      last=last, strain_rate=d, spin=w)
+            else if (self%musl) then
+               call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
+                                      update_velocity=.false., compute_strain=.true., update_position=.true., &
+                                      strain_velocity=self%remapped_momentum, compute_spin=uses_spin, &
+                                      extent=extent, first=first, last=last, strain_rate=d, spin=w)
+            else
+               call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
+                                      update_velocity=.true., compute_strain=.true., update_position=.true., &
+                                      compute_spin=uses_spin, extent=extent, first=first, last=last, &
+                                      strain_rate=d, spin=w)
+            end if
+         end associate
+         self%extent(1:dim, 1) = min(self%extent(1:dim, 1), extent(1:dim, 1))
+         self%extent(1:dim, 2) = max(self%extent(1:dim, 2), extent(1:dim, 2))
+      end subroutine particle_kinematics
+   end subroutine move_particles
 
    !> dt = CFL h / (sqrt(dim) max_p (c_p + |v_p|)), limited by the viscous step CFL rho h^2 / (2 dim mu)
    !> (algorithms.md section 5.4), or the fixed dt of &run. Collective (global maxima of the speeds).

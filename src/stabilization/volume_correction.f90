@@ -217,18 +217,20 @@ contains
       end do
    end subroutine shifts_of_particles
 
-   !> After the position update of the step (particle order unchanged since prepare). A shifted particle
-   !> takes the hydrostatic pressure of its new place, p := p + rho g . dx (first-order Taylor step with
-   !> grad p = rho g): without it, shifting mixes the pressures of different depths into noise.
-   subroutine corrector_apply_shifts(self, particles)
+   !> After the position update of the step (particle order unchanged since prepare), for the particles
+   !> first:last. A shifted particle takes the hydrostatic pressure of its new place, p := p + rho g . dx
+   !> (first-order Taylor step with grad p = rho g): without it, shifting mixes the pressures of different
+   !> depths into noise.
+   subroutine corrector_apply_shifts(self, particles, first, last)
       class(volume_corrector_t), intent(in) :: self
       type(particle_set_t), intent(inout) :: particles
+      integer, intent(in) :: first, last
       integer :: m, p, dim
       if (.not. self%shifting_now) return
       dim = particles%dim
       do m = 1, size(self%shifting_coefficient)
          if (self%shifting_coefficient(m) <= 0.0_rp) cycle
-         do p = particles%material_first(m), particles%material_last(m)
+         do p = max(first, particles%material_first(m)), min(last, particles%material_last(m))
             particles%x(:, p) = particles%x(:, p) + self%shift(:, p)
             ! sbar = -p/rho on the normal components: d(sbar) = -dp/rho = -g . dx
             particles%sbar(1:3, p) = particles%sbar(1:3, p) - dot_product(self%gravity(1:dim), self%shift(:, p))

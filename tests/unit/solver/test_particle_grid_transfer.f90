@@ -101,13 +101,14 @@ contains
       type(solver_t) :: solver
       real(rp), parameter :: a(2, 2) = reshape([0.1_rp, -0.3_rp, 0.2_rp, 0.05_rp], [2, 2]), b(2) = [1.0_rp, -2.0_rp]
       real(rp) :: x(2)
+      real(rp), allocatable :: d(:, :), w(:, :)
       integer :: i, p, rest, g(2)
       call make_solver(comm, 2, solver)
-      ! water: no model reads the spin, so the set holds none; give it room to check G2P's w_p
+      ! water without a scheme: the set holds neither rate nor spin (the step keeps them in a block buffer);
+      ! G2P writes them where it is told
       call assertEqual(0, solver%particles%n_spin, 'a water scene holds no spin')
-      deallocate (solver%particles%spin)
-      solver%particles%n_spin = 1
-      allocate (solver%particles%spin(1, size(solver%particles%mass)))
+      call assertEqual(0, solver%particles%n_rate, 'nor a rate of deformation')
+      allocate (d(4, solver%particles%count), w(1, solver%particles%count))
       do i = 1, solver%grid%node_count
          rest = i - 1
          g(1) = solver%grid%node_lo(1) + mod(rest, solver%grid%n_nodes(1))
@@ -116,12 +117,13 @@ contains
          solver%grid%velocity(:, i) = matmul(a, x) + b
          solver%grid%velocity_increment(:, i) = 0.0_rp
       end do
-      call grid_to_particles(solver%grid, solver%particles, 0.0_rp, 0.0_rp, 1.0_rp, .true., .true., .false.)
+      call grid_to_particles(solver%grid, solver%particles, 0.0_rp, 0.0_rp, 1.0_rp, .true., .true., .false., &
+                             strain_rate=d, spin=w)
       do p = 1, solver%particles%count
          call assertEqual(matmul(a, solver%particles%x(:, p)) + b, solver%particles%v(:, p), 1.0e-13_rp, 'PIC v_p')
-         call assertEqual([a(1, 1), a(2, 2), 0.0_rp, 0.5_rp * (a(1, 2) + a(2, 1))], solver%particles%strain_rate(:, p), &
-                          1.0e-13_rp, 'd_p of a linear field')
-         call assertEqual(0.5_rp * (a(1, 2) - a(2, 1)), solver%particles%spin(1, p), 1.0e-13_rp, 'w_p')
+         call assertEqual([a(1, 1), a(2, 2), 0.0_rp, 0.5_rp * (a(1, 2) + a(2, 1))], d(:, p), 1.0e-13_rp, &
+                          'd_p of a linear field')
+         call assertEqual(0.5_rp * (a(1, 2) - a(2, 1)), w(1, p), 1.0e-13_rp, 'w_p')
       end do
       call solver%free()
    end subroutine test_g2p_reproduces_linear_velocity

@@ -349,7 +349,7 @@ contains
       allocate (corrector%shift(2, 1))
       corrector%shift(:, 1) = [0.003_rp, -0.01_rp]
       corrector%shifting_now = .true.      ! as prepare sets it on the steps that shift
-      call corrector%apply_shifts(particles)
+      call corrector%apply_shifts(particles, 1, particles%count)
       pressure = -1000.0_rp * sum(particles%sbar(1:3, 1)) / 3.0_rp
       ! every rank does the same: the largest pressure over the ranks is the one to check
       call MPI_Allreduce(MPI_IN_PLACE, pressure, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)

@@ -55,6 +55,7 @@ contains
                                                  0.1_rp], [3, 3]), v3(3) = [0.5_rp, -0.25_rp, 0.75_rp]
       type(solver_t) :: solver
       real(rp) :: a(dim, dim), v0(dim), x(dim), m, worst(2)
+      real(rp), allocatable :: d(:, :), w(:, :)
       integer :: p, i, mom
       a = a3(1:dim, 1:dim)
       v0 = v3(1:dim)
@@ -75,12 +76,13 @@ contains
          solver%grid%velocity(:, i) = v0 + matmul(a, x)
          solver%grid%velocity_increment(:, i) = 0.0_rp
       end do
+      allocate (d(solver%particles%n_sigma, solver%particles%count), w(0, solver%particles%count))
       call grid_to_particles(solver%grid, solver%particles, 0.0_rp, 0.95_rp, 1.0_rp, update_velocity=.true., &
-                             compute_strain=.true., update_position=.false.)
+                             compute_strain=.true., update_position=.false., strain_rate=d, spin=w)
       do p = 1, solver%particles%count
          worst(2) = max(worst(2), maxval(abs(solver%particles%v(:, p) - (v0 + matmul(a, solver%particles%x(:, p))))))
          call assertEqual(reshape(a, [dim * dim]), solver%particles%affine(:, p), 1.0e-12_rp, 'G2P: C_p = A')
-         call assertEqual(a(1, 1), solver%particles%strain_rate(1, p), 1.0e-13_rp, 'G2P: d_xx = A_xx')
+         call assertEqual(a(1, 1), d(1, p), 1.0e-13_rp, 'G2P: d_xx = A_xx')
       end do
       call MPI_Allreduce(MPI_IN_PLACE, worst, 2, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
       call assertEqual(0.0_rp, worst(1), 1.0e-13_rp, 'P2G: nodal velocity = v(x_i) at every node with mass')
