@@ -17,7 +17,7 @@ module node_based_anti_locking
    use stabilizer, only: stabilizer_t, stage_context_t
    use background_grid, only: grid_t, row_mass
    use node_halo, only: sum_shared_nodes
-   use node_based_kernels, only: store_shape_values, scatter_to_nodes, gather_from_nodes
+   use node_based_kernels, only: store_shape_values, scatter_to_nodes, gather_from_nodes, divide_by_mass, clear
    implicit none
    private
 
@@ -96,26 +96,16 @@ contains
          if (size(self%nodal, 1) /= size(values, 1) .or. size(self%nodal, 2) < nodes) deallocate (self%nodal)
       end if
       if (.not. allocated(self%nodal)) allocate (self%nodal(size(values, 1), nodes))
+      call clear(size(values, 1) * nodes, self%nodal)
       associate (nodal => self%nodal(:, 1:nodes))
-         nodal = 0.0_rp
          call scatter_to_nodes(grid, self%base, self%weight, particles%mass(context%first:context%last), values, nodal)
          call sum_shared_nodes(context%domain, grid, nodal)
          if (self%own_mass) then
-            call divide(nodal, self%nodal_mass(1, 1:nodes))
+            call divide_by_mass(grid, self%nodal_mass(1, 1:nodes), nodal)
          else
-            call divide(nodal, grid%accumulated(row_mass, 1:nodes))
+            call divide_by_mass(grid, grid%accumulated(row_mass, 1:nodes), nodal)
          end if
          call gather_from_nodes(grid, self%base, self%weight, nodal, values)
       end associate
    end subroutine project_and_interpolate
-
-   !> nodal(:, i) := nodal(:, i) / mass(i) where the material has mass.
-   subroutine divide(nodal, mass)
-      real(rp), intent(inout), contiguous :: nodal(:, :)
-      real(rp), intent(in) :: mass(:)
-      integer :: i
-      do i = 1, size(mass)
-         if (mass(i) > 0.0_rp) nodal(:, i) = nodal(:, i) / mass(i)
-      end do
-   end subroutine divide
 end module node_based_anti_locking

@@ -11,7 +11,7 @@ module node_based_kernels
    implicit none
    private
 
-   public :: store_shape_values, scatter_to_nodes, gather_from_nodes
+   public :: store_shape_values, scatter_to_nodes, gather_from_nodes, divide_by_mass, clear
 
 contains
 
@@ -67,6 +67,27 @@ contains
       end select
    end subroutine gather_from_nodes
 
+   !> nodal(:, i) := nodal(:, i) / mass(i) where mass(i) > 0, i = 1..size(mass).
+   subroutine divide_by_mass(grid, mass, nodal)
+      type(grid_t), intent(in) :: grid
+      real(rp), intent(in) :: mass(:)   !< a row of grid%accumulated may be passed: not contiguous
+      real(rp), intent(inout), contiguous :: nodal(:, :)
+      select case (instance(grid))
+      case (1); call divide_2d(mass, nodal)
+      case (2); call divide_3d(mass, nodal)
+      case (3); call divide_b2_2d(mass, nodal)
+      case default; call divide_b2_3d(mass, nodal)
+      end select
+   end subroutine divide_by_mass
+
+   !> values(1:n) := 0 as one block (an array section of columns was zeroed column by column, one memset
+   !> call per node).
+   subroutine clear(n, values)
+      integer, intent(in) :: n
+      real(rp), intent(out) :: values(n)
+      values = 0.0_rp
+   end subroutine clear
+
 #define KERNEL_DIM 2
 #define N_SIGMA 4
 #define WIDTH 2
@@ -75,6 +96,7 @@ contains
 #define STORE store_2d
 #define SCATTER scatter_2d
 #define GATHER gather_2d
+#define DIVIDE divide_2d
 #include "../grid/multilinear_shape.inc"
 #include "node_based_kernels.inc"
 
@@ -86,6 +108,7 @@ contains
 #define STORE store_3d
 #define SCATTER scatter_3d
 #define GATHER gather_3d
+#define DIVIDE divide_3d
 #include "../grid/multilinear_shape.inc"
 #include "node_based_kernels.inc"
 
@@ -97,6 +120,7 @@ contains
 #define STORE store_b2_2d
 #define SCATTER scatter_b2_2d
 #define GATHER gather_b2_2d
+#define DIVIDE divide_b2_2d
 #include "../grid/bspline2_shape.inc"
 #include "node_based_kernels.inc"
 
@@ -108,6 +132,7 @@ contains
 #define STORE store_b2_3d
 #define SCATTER scatter_b2_3d
 #define GATHER gather_b2_3d
+#define DIVIDE divide_b2_3d
 #include "../grid/bspline2_shape.inc"
 #include "node_based_kernels.inc"
 end module node_based_kernels
