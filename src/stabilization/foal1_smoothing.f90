@@ -16,7 +16,7 @@ module foal1_smoothing
    use cell_binning, only: cell_list_t, bin_cell_mass_and_centre, cell_average, gather_cell_values
    use cell_halo, only: padded_cells_t, exchange_cell_halo, halo_width
    use background_grid, only: grid_t
-   use limited_flux_smoothing, only: flux_options_t, flux_workspace_t, limited_flux_increments
+   use limited_flux_smoothing, only: flux_options_t, flux_workspace_t, field_flux_increments
    implicit none
    private
 
@@ -111,8 +111,7 @@ contains
          end associate
 
          ! (d) limited face fluxes
-         call limited_flux_increments(self%box, context%grid%h, exists, field(2, :), field(3:2 + dim, :), &
-                                      field(3 + dim:, :), self%options, dq, self%workspace)
+         call field_flux_increments(self%box, context%grid%h, exists, field, self%options, dq, self%workspace)
 
          ! (e) particle update
          if (self%pressure_only) then

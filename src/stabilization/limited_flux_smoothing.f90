@@ -36,26 +36,24 @@ module limited_flux_smoothing
    !> Most values smoothed per cell (the 3-D stress).
    integer, parameter :: max_values = 6
 
-   !> Work arrays of limited_flux_increments, kept between calls (a step must not page in fresh memory).
+   !> Work arrays of the flux increments, kept between calls (a step must not page in fresh memory).
    !> A workspace belongs to one dq array: it remembers which part of dq the last call may have made
    !> non-zero, and the next call clears only that part (the rest of the box is air in a tank).
    type, public :: flux_workspace_t
       integer, allocatable :: oscillating(:)   !< bit j - 1 set: component j oscillates along the current axis
       real(rp), allocatable :: scale(:)
+      real(rp), allocatable :: slope(:)        !< eq. 7 slopes along the current axis, (values, cells)
       integer :: written_lo(3) = 1, written_hi(3) = 0   !< box of cells of dq the last call may have written
    end type flux_workspace_t
 
-   public :: limited_flux_increments
+   public :: limited_flux_increments, field_flux_increments
 
 contains
 
    !> dq(:, c) for every owned padded cell c (zero elsewhere). `exists` marks cells holding this material
    !> (owned and ghost); q(:, c), mass(c), centre(:, c) are read only where exists(c). `workspace` keeps
    !> the work arrays between calls; a new one (or one last used with another dq) makes the call zero all
-   !> of dq first.
-   !> The loops run over the bounding box of the existing cells row by row, with the limits along the axis
-   !> in the loop bounds (no per-cell position tests). Faces are visited axis by axis in flat cell order,
-   !> which fixes the order of the sums into dq.
+   !> of dq first. The separate arrays are packed into one cell field for field_flux_increments.
    subroutine limited_flux_increments(box, h, exists, mass, centre, q, options, dq, workspace)
       type(padded_cells_t), intent(in) :: box
       real(rp), intent(in) :: h
@@ -64,16 +62,46 @@ contains
       type(flux_options_t), intent(in) :: options
       real(rp), intent(inout) :: dq(:, :)
       type(flux_workspace_t), intent(inout) :: workspace
-      integer :: k, nq, c, stride, i1, i2, i3, lo(3), hi(3), flo(3), fhi(3)
+      real(rp), allocatable :: field(:, :)
+      integer :: dim
+      dim = size(centre, 1)
+      allocate (field(2 + dim + size(q, 1), box%count))
+      field(1, :) = merge(1.0_rp, 0.0_rp, exists)
+      field(2, :) = mass
+      field(3:2 + dim, :) = centre
+      field(3 + dim:, :) = q
+      call field_flux_increments(box, h, exists, field, options, dq, workspace)
+   end subroutine limited_flux_increments
 
-      nq = size(q, 1)
-      if (allocated(workspace%oscillating)) then
-         if (size(workspace%oscillating) /= box%count) deallocate (workspace%oscillating, workspace%scale)
+   !> As limited_flux_increments, on the cell field of cell_halo's exchange: field(:, c) = [flag, m_c,
+   !> x_o^c (box%dim values), q_c], one column per padded cell; dq is (size(q_c), box%count).
+   !> The loops run over the bounding box of the existing cells row by row, with the limits along the axis
+   !> in the loop bounds (no per-cell position tests). Faces are visited axis by axis in flat cell order,
+   !> which fixes the order of the sums into dq.
+   subroutine field_flux_increments(box, h, exists, field, options, dq, workspace)
+      type(padded_cells_t), intent(in) :: box
+      real(rp), intent(in) :: h
+      logical, intent(in) :: exists(:)
+      real(rp), contiguous, intent(in) :: field(:, :)
+      type(flux_options_t), intent(in) :: options
+      real(rp), contiguous, intent(inout) :: dq(:, :)
+      type(flux_workspace_t), intent(inout) :: workspace
+      integer :: nq, lo(3), hi(3)
+
+      nq = size(field, 1) - 2 - box%dim
+      if (.not. ((box%dim == 2 .and. nq == 4) .or. (box%dim == 3 .and. nq == 6))) then
+         call increments_any(box, h, exists, field(2, :), field(3:2 + box%dim, :), field(3 + box%dim:, :), options, &
+                             dq, workspace)
+         return
       end if
       if (allocated(workspace%oscillating)) then
-         call clear_box(box, workspace%written_lo, workspace%written_hi, dq)
+         if (size(workspace%oscillating) /= box%count .or. size(workspace%slope) /= nq * box%count) &
+            deallocate (workspace%oscillating, workspace%scale, workspace%slope)
+      end if
+      if (allocated(workspace%oscillating)) then
+         call clear_box(nq, box, workspace%written_lo, workspace%written_hi, dq)
       else
-         allocate (workspace%oscillating(box%count), workspace%scale(box%count))
+         allocate (workspace%oscillating(box%count), workspace%scale(box%count), workspace%slope(nq * box%count))
          dq = 0.0_rp
       end if
       call existing_bounds(box, exists, lo, hi)
@@ -81,49 +109,75 @@ contains
       workspace%written_lo = lo
       workspace%written_hi = hi
       if (any(hi < lo)) return
-      associate (oscillating => workspace%oscillating, scale => workspace%scale)
-         do i3 = lo(3), hi(3)
-            do i2 = lo(2), hi(2)
-               c = flat_index(box, lo(1), i2, i3)
-               do i1 = lo(1), hi(1)
-                  if (exists(c)) scale(c) = noise_guard * maxval(abs(q(:, c)))     ! round-off scale (see noise_guard)
+      ! literal sizes for the 2-D and 3-D stress: the compiler unrolls the components and the centre
+      if (box%dim == 2) then
+         call flux_increments(2, 4, box, h, exists, field, options, lo, hi, workspace%oscillating, workspace%scale, &
+                              workspace%slope, dq)
+      else
+         call flux_increments(3, 6, box, h, exists, field, options, lo, hi, workspace%oscillating, workspace%scale, &
+                              workspace%slope, dq)
+      end if
+   end subroutine field_flux_increments
+
+   !> The work of field_flux_increments on the bounding box lo:hi of the existing cells, with the
+   !> dimension and the number of values as arguments (literals at the calls that matter).
+   subroutine flux_increments(dim, nq, box, h, exists, field, options, lo, hi, oscillating, scale, slope, dq)
+      integer, intent(in) :: dim, nq, lo(3), hi(3)
+      type(padded_cells_t), intent(in) :: box
+      real(rp), intent(in) :: h
+      logical, intent(in) :: exists(*)
+      real(rp), intent(in) :: field(2 + dim + nq, *)
+      type(flux_options_t), intent(in) :: options
+      integer, intent(inout) :: oscillating(*)
+      real(rp), intent(inout) :: scale(*), slope(nq, *), dq(nq, *)
+      integer :: k, c, stride, i1, i2, i3, flo(3), fhi(3), j
+      real(rp) :: d_min, largest
+      d_min = min_centre_distance * h
+      do i3 = lo(3), hi(3)
+         do i2 = lo(2), hi(2)
+            c = flat_index(box, lo(1), i2, i3)
+            do i1 = lo(1), hi(1)
+               if (exists(c)) then     ! round-off scale (see noise_guard); max, not maxval: no NaN tests
+                  largest = abs(field(3 + dim, c))
+                  do j = 2, nq
+                     largest = max(largest, abs(field(2 + dim + j, c)))
+                  end do
+                  scale(c) = noise_guard * largest
+               end if
+               c = c + 1
+            end do
+         end do
+      end do
+      do k = 1, dim
+         stride = box%stride(k)
+         ! oscillation flags (eq. 6) and slopes (eq. 7) of the cells with both neighbours along k inside
+         ! the padded box
+         flo = lo
+         fhi = hi
+         flo(k) = max(lo(k), 2)
+         fhi(k) = min(hi(k), box%n(k) - 1)
+         do i3 = flo(3), fhi(3)
+            do i2 = flo(2), fhi(2)
+               c = flat_index(box, flo(1), i2, i3)
+               call row_oscillation_bits(dim, nq, k, exists, scale, field, c, fhi(1) - flo(1) + 1, stride, d_min, &
+                                         oscillating, slope)
+            end do
+         end do
+         ! faces (c, c + stride) with c two or more layers inside the box and c + stride in the bounding box
+         flo(k) = max(lo(k), 2)
+         fhi(k) = min(hi(k) - 1, box%n(k) - 2)
+         do i3 = flo(3), fhi(3)
+            do i2 = flo(2), fhi(2)
+               c = flat_index(box, flo(1), i2, i3)
+               do i1 = flo(1), fhi(1)
+                  if (ior(oscillating(c), oscillating(c + stride)) /= 0) &
+                     call face_flux(dim, nq, box, exists, field, options, oscillating, slope, c, k, dq)
                   c = c + 1
                end do
             end do
          end do
-         do k = 1, box%dim
-            stride = box%stride(k)
-            ! oscillation flags (eq. 6) of the cells with both neighbours along k inside the padded box
-            flo = lo
-            fhi = hi
-            flo(k) = max(lo(k), 2)
-            fhi(k) = min(hi(k), box%n(k) - 1)
-            do i3 = flo(3), fhi(3)
-               do i2 = flo(2), fhi(2)
-                  c = flat_index(box, flo(1), i2, i3)
-                  if (nq == 4) then     ! a literal count unrolls the components (2-D stress)
-                     call row_oscillation_bits(4, exists, scale, q, c, fhi(1) - flo(1) + 1, stride, oscillating)
-                  else
-                     call row_oscillation_bits(nq, exists, scale, q, c, fhi(1) - flo(1) + 1, stride, oscillating)
-                  end if
-               end do
-            end do
-            ! faces (c, c + stride) with c two or more layers inside the box and c + stride in the bounding box
-            flo(k) = max(lo(k), 2)
-            fhi(k) = min(hi(k) - 1, box%n(k) - 2)
-            do i3 = flo(3), fhi(3)
-               do i2 = flo(2), fhi(2)
-                  c = flat_index(box, flo(1), i2, i3)
-                  do i1 = flo(1), fhi(1)
-                     if (ior(oscillating(c), oscillating(c + stride)) /= 0) &
-                        call face_flux(box, h, exists, mass, centre, q, options, oscillating, c, k, dq)
-                     c = c + 1
-                  end do
-               end do
-            end do
-         end do
-      end associate
-   end subroutine limited_flux_increments
+      end do
+   end subroutine flux_increments
 
    !> Bounding box lo:hi (padded coordinates) of the existing cells; hi < lo if there are none.
    subroutine existing_bounds(box, exists, lo, hi)
@@ -155,16 +209,18 @@ contains
 
    !> dq := 0 on the cells lo..hi (padded coordinates), row by row (not the flat range between its
    !> corners: that covers whole rows of the padded box, most of it air beside a column of water).
-   subroutine clear_box(box, lo, hi, dq)
+   !> dq is read flat (nq values per cell): a row is one contiguous range.
+   subroutine clear_box(nq, box, lo, hi, dq)
+      integer, intent(in) :: nq
       type(padded_cells_t), intent(in) :: box
       integer, intent(in) :: lo(3), hi(3)
-      real(rp), intent(inout) :: dq(:, :)
+      real(rp), intent(inout) :: dq(*)
       integer :: i2, i3, c
       if (any(hi < lo)) return
       do i3 = lo(3), hi(3)
          do i2 = lo(2), hi(2)
             c = flat_index(box, lo(1), i2, i3)
-            dq(:, c:c + hi(1) - lo(1)) = 0.0_rp
+            dq(nq * (c - 1) + 1:nq * (c + hi(1) - lo(1))) = 0.0_rp
          end do
       end do
    end subroutine clear_box
@@ -175,13 +231,177 @@ contains
       flat_index = 1 + (i1 - 1) + (i2 - 1) * box%stride(2) + (i3 - 1) * box%stride(3)
    end function flat_index
 
+   !> Eq. 6 per component for the cells first..first + count - 1 along the axis k of `stride`, as bits
+   !> (bit j - 1: component j), with the noise guard: both differences above round-off and of opposite
+   !> sign. 0 if the cell or a neighbour is missing (a cell missing a neighbour cannot be tested [?]).
+   !> The components are tested without branches: in a flow that has just been set in motion half the
+   !> cells oscillate, at random, and a branch per test was mispredicted half the time (measured on the
+   !> collapsing water column). Cells without the material are not read (their values are anything).
+   !> Also the eq. 7 slope along k of every existing cell of the row: central with both neighbours,
+   !> one-sided with one, else 0. Most faces of a flow in motion are active, and a cell's slope serves
+   !> both of its faces: once per cell here rather than twice per face.
+   subroutine row_oscillation_bits(dim, nq, k, exists, scale, field, first, count, stride, d_min, oscillating, slope)
+      integer, intent(in) :: dim, nq, k, first, count, stride
+      logical, intent(in) :: exists(*)
+      real(rp), intent(in) :: scale(*), field(2 + dim + nq, *), d_min
+      integer, intent(inout) :: oscillating(*)
+      real(rp), intent(inout) :: slope(nq, *)
+      real(rp) :: noise, left, right, distance
+      integer :: j, c, bits, lower, upper
+      do c = first, first + count - 1
+         oscillating(c) = 0
+         if (.not. exists(c)) cycle
+         if (exists(c - stride) .and. exists(c + stride)) then
+            noise = max(scale(c - stride), scale(c), scale(c + stride))
+            bits = 0
+            do j = 1, nq
+               left = field(2 + dim + j, c) - field(2 + dim + j, c - stride)
+               right = field(2 + dim + j, c + stride) - field(2 + dim + j, c)
+               bits = ior(bits, merge(ishft(1, j - 1), 0, (abs(right) > noise) .and. (abs(left) > noise) .and. &
+                                                          (right * left < 0.0_rp)))
+            end do
+            oscillating(c) = bits
+            lower = c - stride
+            upper = c + stride
+         else if (exists(c - stride)) then
+            lower = c - stride
+            upper = c
+         else if (exists(c + stride)) then
+            lower = c
+            upper = c + stride
+         else
+            slope(:, c) = 0.0_rp
+            cycle
+         end if
+         distance = max(field(2 + k, upper) - field(2 + k, lower), d_min)
+         slope(:, c) = (field(3 + dim:2 + dim + nq, upper) - field(3 + dim:2 + dim + nq, lower)) / distance
+      end do
+   end subroutine row_oscillation_bits
+
+   !> The limited flux across the face (c, c + stride of axis k), if both cells exist, at least one is
+   !> owned, and the face is active for some component; added to dq of the owned side(s).
+   subroutine face_flux(dim, nq, box, exists, field, options, oscillating, slope, c, k, dq)
+      integer, intent(in) :: dim, nq
+      type(padded_cells_t), intent(in) :: box
+      logical, intent(in) :: exists(*)
+      real(rp), intent(in) :: field(2 + dim + nq, *), slope(nq, *)
+      type(flux_options_t), intent(in) :: options
+      integer, intent(in) :: oscillating(*), c, k
+      real(rp), intent(inout) :: dq(nq, *)
+      integer :: j, right, active
+      real(rp) :: n_faces, flux, jump, limited_jump, x_m, allowed
+      logical :: owned_minus, owned_plus
+      right = c + box%stride(k)
+      if (.not. (exists(c) .and. exists(right))) return
+      owned_minus = box%owned(c)
+      owned_plus = box%owned(right)
+      if (.not. (owned_minus .or. owned_plus)) return
+      ! oscillation limiter (eq. 6): gamma_o = gamma_max on an active face, else no flux
+      if (options%both_cells_oscillate) then
+         active = iand(oscillating(c), oscillating(right))
+      else
+         active = ior(oscillating(c), oscillating(right))
+      end if
+      if (active == 0) return
+      n_faces = real(2 * dim, rp)
+      associate (m_minus => field(2, c), m_plus => field(2, right), x_minus => field(2 + k, c), &
+                 x_plus => field(2 + k, right))
+         x_m = (m_minus * x_plus + m_plus * x_minus) / (m_minus + m_plus)         ! eq. 8
+         do j = 1, nq
+            if (.not. btest(active, j - 1)) cycle
+            jump = field(2 + dim + j, c) - field(2 + dim + j, right)
+            allowed = (x_m - x_minus) * slope(j, c) - (x_m - x_plus) * slope(j, right)   ! e_- - e_+
+            limited_jump = sign0(jump) * min(max(sign0(jump) * (jump + allowed), 0.0_rp), abs(jump))  ! eq. 12
+            flux = options%gamma_max * limited_jump / (n_faces * (m_minus + m_plus))   ! eqs. 5, 11, 1/n
+            if (owned_plus) dq(j, right) = dq(j, right) + m_minus * flux
+            if (owned_minus) dq(j, c) = dq(j, c) - m_plus * flux
+         end do
+      end associate
+   end subroutine face_flux
+
+
+   ! --- Other numbers of values per cell (FOAL1 on the pressure alone: one): the code of before the
+   ! compile-time kernels, kept as it was. Rewritten like the kernels it gave results that differ
+   ! in the last bits (the compiler fuses a different set of multiply-adds), and results must stay
+   ! bitwise the same. ---
+
+   subroutine increments_any(box, h, exists, mass, centre, q, options, dq, workspace)
+      type(padded_cells_t), intent(in) :: box
+      real(rp), intent(in) :: h
+      logical, intent(in) :: exists(:)
+      real(rp), intent(in) :: mass(:), centre(:, :), q(:, :)
+      type(flux_options_t), intent(in) :: options
+      real(rp), intent(inout) :: dq(:, :)
+      type(flux_workspace_t), intent(inout) :: workspace
+      integer :: k, nq, c, stride, i1, i2, i3, lo(3), hi(3), flo(3), fhi(3)
+
+      nq = size(q, 1)
+      if (allocated(workspace%oscillating)) then
+         if (size(workspace%oscillating) /= box%count .or. size(workspace%slope) /= size(q, 1) * box%count) &
+            deallocate (workspace%oscillating, workspace%scale, workspace%slope)
+      end if
+      if (allocated(workspace%oscillating)) then
+         call clear_box(size(dq, 1), box, workspace%written_lo, workspace%written_hi, dq)
+      else
+         allocate (workspace%oscillating(box%count), workspace%scale(box%count), workspace%slope(size(q, 1) * box%count))
+         dq = 0.0_rp
+      end if
+      call existing_bounds(box, exists, lo, hi)
+      ! every face flux goes to cells of the bounding box
+      workspace%written_lo = lo
+      workspace%written_hi = hi
+      if (any(hi < lo)) return
+      associate (oscillating => workspace%oscillating, scale => workspace%scale)
+         do i3 = lo(3), hi(3)
+            do i2 = lo(2), hi(2)
+               c = flat_index(box, lo(1), i2, i3)
+               do i1 = lo(1), hi(1)
+                  if (exists(c)) scale(c) = noise_guard * maxval(abs(q(:, c)))     ! round-off scale (see noise_guard)
+                  c = c + 1
+               end do
+            end do
+         end do
+         do k = 1, box%dim
+            stride = box%stride(k)
+            ! oscillation flags (eq. 6) of the cells with both neighbours along k inside the padded box
+            flo = lo
+            fhi = hi
+            flo(k) = max(lo(k), 2)
+            fhi(k) = min(hi(k), box%n(k) - 1)
+            do i3 = flo(3), fhi(3)
+               do i2 = flo(2), fhi(2)
+                  c = flat_index(box, flo(1), i2, i3)
+                  if (nq == 4) then     ! a literal count unrolls the components (2-D stress)
+                     call oscillation_bits_any(4, exists, scale, q, c, fhi(1) - flo(1) + 1, stride, oscillating)
+                  else
+                     call oscillation_bits_any(nq, exists, scale, q, c, fhi(1) - flo(1) + 1, stride, oscillating)
+                  end if
+               end do
+            end do
+            ! faces (c, c + stride) with c two or more layers inside the box and c + stride in the bounding box
+            flo(k) = max(lo(k), 2)
+            fhi(k) = min(hi(k) - 1, box%n(k) - 2)
+            do i3 = flo(3), fhi(3)
+               do i2 = flo(2), fhi(2)
+                  c = flat_index(box, flo(1), i2, i3)
+                  do i1 = flo(1), fhi(1)
+                     if (ior(oscillating(c), oscillating(c + stride)) /= 0) &
+                        call face_flux_any(box, h, exists, mass, centre, q, options, oscillating, c, k, dq)
+                     c = c + 1
+                  end do
+               end do
+            end do
+         end do
+      end associate
+   end subroutine increments_any
+
    !> Eq. 6 per component for the cells first..first + count - 1 along the axis of `stride`, as bits
    !> (bit j - 1: component j), with the noise guard: both differences above round-off and of opposite
    !> sign. 0 if the cell or a neighbour is missing (a cell missing a neighbour cannot be tested [?]).
    !> The components are tested without branches: in a flow that has just been set in motion half the
    !> cells oscillate, at random, and a branch per test was mispredicted half the time (measured on the
    !> collapsing water column). Cells without the material are not read (their values are anything).
-   subroutine row_oscillation_bits(nq, exists, scale, q, first, count, stride, oscillating)
+   subroutine oscillation_bits_any(nq, exists, scale, q, first, count, stride, oscillating)
       integer, intent(in) :: nq, first, count, stride
       logical, intent(in) :: exists(:)
       real(rp), intent(in) :: scale(:), q(:, :)
@@ -201,11 +421,11 @@ contains
          end do
          oscillating(c) = bits
       end do
-   end subroutine row_oscillation_bits
+   end subroutine oscillation_bits_any
 
    !> The limited flux across the face (c, c + stride of axis k), if both cells exist, at least one is
    !> owned, and the face is active for some component; added to dq of the owned side(s).
-   subroutine face_flux(box, h, exists, mass, centre, q, options, oscillating, c, k, dq)
+   subroutine face_flux_any(box, h, exists, mass, centre, q, options, oscillating, c, k, dq)
       type(padded_cells_t), intent(in) :: box
       real(rp), intent(in) :: h
       logical, intent(in) :: exists(:)
@@ -230,8 +450,8 @@ contains
       n_faces = real(2 * box%dim, rp)
       d_min = min_centre_distance * h
       ! slopes (eq. 7) of the two cells, only for the faces that can carry a flux
-      call cell_slope(box, exists, centre, q, c, k, d_min, active, slope_minus)
-      call cell_slope(box, exists, centre, q, right, k, d_min, active, slope_plus)
+      call cell_slope_any(box, exists, centre, q, c, k, d_min, active, slope_minus)
+      call cell_slope_any(box, exists, centre, q, right, k, d_min, active, slope_plus)
       associate (m_minus => mass(c), m_plus => mass(right), x_minus => centre(k, c), x_plus => centre(k, right))
          x_m = (m_minus * x_plus + m_plus * x_minus) / (m_minus + m_plus)         ! eq. 8
          do j = 1, size(q, 1)
@@ -244,14 +464,14 @@ contains
             if (box%owned(c)) dq(j, c) = dq(j, c) - m_plus * flux
          end do
       end associate
-   end subroutine face_flux
+   end subroutine face_flux_any
 
 
    !> Eq. 7 slope along axis k of cell c (of a face that lies inside the padded box, so both of c's
    !> neighbours along k are inside it too): central with both neighbours, one-sided with one, else 0.
    !> Only the components whose bit is set in `active` are computed (a division each); the others are
    !> left undefined.
-   pure subroutine cell_slope(box, exists, centre, q, c, k, d_min, active, slope)
+   pure subroutine cell_slope_any(box, exists, centre, q, c, k, d_min, active, slope)
       type(padded_cells_t), intent(in) :: box
       logical, intent(in) :: exists(:)
       real(rp), intent(in) :: centre(:, :), q(:, :), d_min
@@ -278,7 +498,7 @@ contains
       do j = 1, size(q, 1)
          if (btest(active, j - 1)) slope(j) = (q(j, upper) - q(j, lower)) / distance
       end do
-   end subroutine cell_slope
+   end subroutine cell_slope_any
 
 
    !> sign returning -1, 0 or +1 ([Y17] section 3.5).
