@@ -18,7 +18,8 @@ EXTERNAL_MODULES = {
     "mpi_f08", "mpi", "hdf5", "h5lt", "omp_lib",
 }
 MODULE_RE = re.compile(r"^\s*module\s+(\w+)\s*(?:!.*)?$", re.IGNORECASE | re.MULTILINE)
-USE_RE = re.compile(r"^\s*use\s*(?:,\s*(?:intrinsic|non_intrinsic)\s*)?(?:::)?\s*(\w+)",
+# after `use` a space, `::` or `, intrinsic ::`: a variable such as `uses_spin = ...` is no use statement
+USE_RE = re.compile(r"^\s*use(?:\s*,\s*(?:intrinsic|non_intrinsic)\s*::|\s*::|\s)\s*(\w+)",
                     re.IGNORECASE | re.MULTILINE)
 
 
