@@ -94,20 +94,7 @@ contains
                              dq, workspace)
          return
       end if
-      if (allocated(workspace%oscillating)) then
-         if (size(workspace%oscillating) /= box%count .or. size(workspace%slope) /= nq * box%count) &
-            deallocate (workspace%oscillating, workspace%scale, workspace%slope)
-      end if
-      if (allocated(workspace%oscillating)) then
-         call clear_box(nq, box, workspace%written_lo, workspace%written_hi, dq)
-      else
-         allocate (workspace%oscillating(box%count), workspace%scale(box%count), workspace%slope(nq * box%count))
-         dq = 0.0_rp
-      end if
-      call existing_bounds(box, exists, lo, hi)
-      ! every face flux goes to cells of the bounding box
-      workspace%written_lo = lo
-      workspace%written_hi = hi
+      call start_workspace(nq, box, exists, dq, workspace, lo, hi)
       if (any(hi < lo)) return
       ! literal sizes for the 2-D and 3-D stress: the compiler unrolls the components and the centre
       if (box%dim == 2) then
@@ -178,6 +165,31 @@ contains
          end do
       end do
    end subroutine flux_increments
+
+   !> The work arrays for nq values per cell (kept while the box and nq stay), dq zero on the box (only the
+   !> cells the last call wrote, when the arrays are kept), and the bounding box lo:hi of the existing
+   !> cells, which every face flux of this call writes into (hi < lo: none).
+   subroutine start_workspace(nq, box, exists, dq, workspace, lo, hi)
+      integer, intent(in) :: nq
+      type(padded_cells_t), intent(in) :: box
+      logical, intent(in) :: exists(:)
+      real(rp), contiguous, intent(inout) :: dq(:, :)
+      type(flux_workspace_t), intent(inout) :: workspace
+      integer, intent(out) :: lo(3), hi(3)
+      if (allocated(workspace%oscillating)) then
+         if (size(workspace%oscillating) /= box%count .or. size(workspace%slope) /= nq * box%count) &
+            deallocate (workspace%oscillating, workspace%scale, workspace%slope)
+      end if
+      if (allocated(workspace%oscillating)) then
+         call clear_box(nq, box, workspace%written_lo, workspace%written_hi, dq)
+      else
+         allocate (workspace%oscillating(box%count), workspace%scale(box%count), workspace%slope(nq * box%count))
+         dq = 0.0_rp
+      end if
+      call existing_bounds(box, exists, lo, hi)
+      workspace%written_lo = lo
+      workspace%written_hi = hi
+   end subroutine start_workspace
 
    !> Bounding box lo:hi (padded coordinates) of the existing cells; hi < lo if there are none.
    subroutine existing_bounds(box, exists, lo, hi)
@@ -336,20 +348,7 @@ contains
       integer :: k, nq, c, stride, i1, i2, i3, lo(3), hi(3), flo(3), fhi(3)
 
       nq = size(q, 1)
-      if (allocated(workspace%oscillating)) then
-         if (size(workspace%oscillating) /= box%count .or. size(workspace%slope) /= size(q, 1) * box%count) &
-            deallocate (workspace%oscillating, workspace%scale, workspace%slope)
-      end if
-      if (allocated(workspace%oscillating)) then
-         call clear_box(size(dq, 1), box, workspace%written_lo, workspace%written_hi, dq)
-      else
-         allocate (workspace%oscillating(box%count), workspace%scale(box%count), workspace%slope(size(q, 1) * box%count))
-         dq = 0.0_rp
-      end if
-      call existing_bounds(box, exists, lo, hi)
-      ! every face flux goes to cells of the bounding box
-      workspace%written_lo = lo
-      workspace%written_hi = hi
+      call start_workspace(nq, box, exists, dq, workspace, lo, hi)
       if (any(hi < lo)) return
       associate (oscillating => workspace%oscillating, scale => workspace%scale)
          do i3 = lo(3), hi(3)

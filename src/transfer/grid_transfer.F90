@@ -132,25 +132,24 @@ contains
    !> update_position; 0 beyond dim): the active region's check needs it, and here it costs no pass.
    !> With `field` (contact): particle p reads v, dv (and the strain velocity) of its field, rows
    !> field(p) dim + 1.. of `velocity` and `increment` (dim (fields + 1), node), not the grid's.
-   !> `first`, `last` (default: all particles) restrict it to a slice; `strain_rate` and `spin` (columns
-   !> 1.. for particles first..) receive d_p and w_p instead of the particles' own arrays, so that the
-   !> stress update can follow on a block that is still in cache (the solver's fused stage, which keeps
-   !> no per-particle rate of deformation; docs/performance.md, "Memory per particle").
+   !> `first`, `last` (default: all particles) restrict it to a slice. d_p and w_p of particle p go to
+   !> column p - first + 1 of `strain_rate` (n_sigma rows when compute_strain) and `spin` (no rows: no
+   !> spin): the particles' own arrays, or the block buffer of the solver's fused stage, on which the
+   !> stress update follows while it is in cache (docs/performance.md, "Memory per particle").
    subroutine grid_to_particles(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
-                                update_position, strain_velocity, compute_spin, extent, field, velocity, increment, &
-                                first, last, strain_rate, spin)
+                                update_position, strain_rate, spin, strain_velocity, compute_spin, extent, field, &
+                                velocity, increment, first, last)
       type(grid_t), intent(in) :: grid
-      type(particle_set_t), intent(inout), target :: particles
+      type(particle_set_t), intent(inout) :: particles
       real(rp), intent(in) :: dt, flip_fraction, theta
       logical, intent(in) :: update_velocity, compute_strain, update_position
+      real(rp), intent(inout), contiguous :: strain_rate(:, :), spin(:, :)
       real(rp), intent(in), optional, contiguous :: strain_velocity(:, :)
       logical, intent(in), optional :: compute_spin
       real(rp), intent(out), optional :: extent(3, 2)
       integer, intent(in), optional :: field(:)
       real(rp), intent(in), optional, contiguous :: velocity(:, :), increment(:, :)
       integer, intent(in), optional :: first, last
-      real(rp), intent(inout), optional, contiguous, target :: strain_rate(:, :), spin(:, :)
-      real(rp), pointer, contiguous :: rate_out(:, :), spin_out(:, :)
       real(rp) :: lo(3), hi(3)
       integer :: p1, p2
       logical :: with_spin
@@ -158,88 +157,78 @@ contains
       p2 = particles%count
       if (present(first)) p1 = first
       if (present(last)) p2 = last
-      if (present(strain_rate)) then
-         rate_out => strain_rate
-         spin_out => spin
-      else
-         rate_out => particles%strain_rate(:, p1:)
-         spin_out => particles%spin(:, p1:)
-      end if
       with_spin = compute_strain
       if (present(compute_spin)) with_spin = compute_strain .and. compute_spin
-      with_spin = with_spin .and. size(spin_out, 1) > 0       ! a set without spin (no model reads it)
-      ! a caller error, not an input error: the rate of deformation needs somewhere to go
-      if (compute_strain .and. size(rate_out, 1) < particles%n_sigma) &
-         error stop 'grid_to_particles: no storage for the rate of deformation (particles%init strain_rate)'
+      with_spin = with_spin .and. size(spin, 1) > 0       ! no rows: a set without spin (no model reads it)
       lo = 0.0_rp
       hi = 0.0_rp
       if (present(field)) then
          select case (transfer_instance(grid, particles))
          case (kernels_linear_2d)
             call grid_to_particles_fields_2d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
-                                             compute_strain, with_spin, update_position, rate_out, spin_out, &
+                                             compute_strain, with_spin, update_position, strain_rate, spin, &
                                              lo(1:2), hi(1:2), field, velocity, increment, strain_velocity)
          case (kernels_linear_3d)
             call grid_to_particles_fields_3d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
-                                             compute_strain, with_spin, update_position, rate_out, spin_out, lo, hi, &
+                                             compute_strain, with_spin, update_position, strain_rate, spin, lo, hi, &
                                              field, velocity, increment, strain_velocity)
          case (kernels_bspline2_2d)
             call grid_to_particles_fields_b2_2d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
-                                                compute_strain, with_spin, update_position, rate_out, spin_out, &
+                                                compute_strain, with_spin, update_position, strain_rate, spin, &
                                                 lo(1:2), hi(1:2), field, velocity, increment, strain_velocity)
          case (kernels_bspline2_3d)
             call grid_to_particles_fields_b2_3d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
-                                                compute_strain, with_spin, update_position, rate_out, spin_out, lo, &
+                                                compute_strain, with_spin, update_position, strain_rate, spin, lo, &
                                                 hi, field, velocity, increment, strain_velocity)
          case (apic + kernels_linear_2d)
             call grid_to_particles_fields_apic_2d(grid, particles, p1, p2, dt, theta, update_velocity, &
-                                                  compute_strain, with_spin, update_position, rate_out, spin_out, &
+                                                  compute_strain, with_spin, update_position, strain_rate, spin, &
                                                   lo(1:2), hi(1:2), field, velocity, increment, strain_velocity)
          case (apic + kernels_linear_3d)
             call grid_to_particles_fields_apic_3d(grid, particles, p1, p2, dt, theta, update_velocity, &
-                                                  compute_strain, with_spin, update_position, rate_out, spin_out, &
+                                                  compute_strain, with_spin, update_position, strain_rate, spin, &
                                                   lo, hi, field, velocity, increment, strain_velocity)
          case (apic + kernels_bspline2_2d)
             call grid_to_particles_fields_apic_b2_2d(grid, particles, p1, p2, dt, theta, update_velocity, &
-                                                     compute_strain, with_spin, update_position, rate_out, spin_out, &
+                                                     compute_strain, with_spin, update_position, strain_rate, spin, &
                                                      lo(1:2), hi(1:2), field, velocity, increment, strain_velocity)
          case default
             call grid_to_particles_fields_apic_b2_3d(grid, particles, p1, p2, dt, theta, update_velocity, &
-                                                     compute_strain, with_spin, update_position, rate_out, spin_out, &
+                                                     compute_strain, with_spin, update_position, strain_rate, spin, &
                                                      lo, hi, field, velocity, increment, strain_velocity)
          end select
       else
          select case (transfer_instance(grid, particles))
          case (kernels_linear_2d)
             call grid_to_particles_2d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
-                                      compute_strain, with_spin, update_position, rate_out, spin_out, lo(1:2), &
+                                      compute_strain, with_spin, update_position, strain_rate, spin, lo(1:2), &
                                       hi(1:2), strain_velocity)
          case (kernels_linear_3d)
             call grid_to_particles_3d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
-                                      compute_strain, with_spin, update_position, rate_out, spin_out, lo, hi, &
+                                      compute_strain, with_spin, update_position, strain_rate, spin, lo, hi, &
                                       strain_velocity)
          case (kernels_bspline2_2d)
             call grid_to_particles_b2_2d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
-                                         compute_strain, with_spin, update_position, rate_out, spin_out, lo(1:2), &
+                                         compute_strain, with_spin, update_position, strain_rate, spin, lo(1:2), &
                                          hi(1:2), strain_velocity)
          case (kernels_bspline2_3d)
             call grid_to_particles_b2_3d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
-                                         compute_strain, with_spin, update_position, rate_out, spin_out, lo, hi, &
+                                         compute_strain, with_spin, update_position, strain_rate, spin, lo, hi, &
                                          strain_velocity)
          case (apic + kernels_linear_2d)
             call grid_to_particles_apic_2d(grid, particles, p1, p2, dt, theta, update_velocity, compute_strain, &
-                                           with_spin, update_position, rate_out, spin_out, lo(1:2), hi(1:2), &
+                                           with_spin, update_position, strain_rate, spin, lo(1:2), hi(1:2), &
                                            strain_velocity)
          case (apic + kernels_linear_3d)
             call grid_to_particles_apic_3d(grid, particles, p1, p2, dt, theta, update_velocity, compute_strain, &
-                                           with_spin, update_position, rate_out, spin_out, lo, hi, strain_velocity)
+                                           with_spin, update_position, strain_rate, spin, lo, hi, strain_velocity)
          case (apic + kernels_bspline2_2d)
             call grid_to_particles_apic_b2_2d(grid, particles, p1, p2, dt, theta, update_velocity, compute_strain, &
-                                              with_spin, update_position, rate_out, spin_out, lo(1:2), hi(1:2), &
+                                              with_spin, update_position, strain_rate, spin, lo(1:2), hi(1:2), &
                                               strain_velocity)
          case default
             call grid_to_particles_apic_b2_3d(grid, particles, p1, p2, dt, theta, update_velocity, compute_strain, &
-                                              with_spin, update_position, rate_out, spin_out, lo, hi, &
+                                              with_spin, update_position, strain_rate, spin, lo, hi, &
                                               strain_velocity)
          end select
       end if

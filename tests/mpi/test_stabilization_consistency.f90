@@ -386,7 +386,8 @@ contains
       context%last = solver%particles%material_last(1)
       x_n = solver%particles%x(:, 1:solver%particles%count)
       call solver%schemes(1)%scheme%prepare(context, solver%particles)
-      call grid_to_particles(solver%grid, solver%particles, 1.0e-3_rp, 1.0_rp, 1.0_rp, .false., .true., .false.)
+      call grid_to_particles(solver%grid, solver%particles, 1.0e-3_rp, 1.0_rp, 1.0_rp, .false., .true., .false., &
+                             solver%particles%strain_rate, solver%particles%spin)
       call solver%schemes(1)%scheme%filter_strain_rate(context, solver%particles)
       allocate (centre(2, solver%grid%cell_count), mass(solver%grid%cell_count))
       centre = 0.0_rp

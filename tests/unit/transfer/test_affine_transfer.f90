@@ -148,7 +148,8 @@ contains
          solver%grid%velocity_increment(:, i) = 0.0_rp
       end do
       call grid_to_particles(solver%grid, solver%particles, 0.0_rp, 0.95_rp, 1.0_rp, update_velocity=.true., &
-                             compute_strain=.false., update_position=.false.)
+                             compute_strain=.false., update_position=.false., strain_rate=solver%particles%strain_rate, &
+                             spin=solver%particles%spin)
       l_back = particle_angular_momentum(solver%particles, solver%grid, comm)
       call assertEqual(l_particles, l_back, 1.0e-12_rp * maxval(abs(l_particles)), 'G2P gives the angular momentum back')
       call solver%free()
