@@ -75,7 +75,7 @@ module boundary_walls
 
    public :: build_walls, box_side_walls, make_wall, make_structure, build_structures, set_wall_activity, &
              apply_wall_constraints, keep_particles_inside, behind_wall, wall_distance, unilateral_velocity, &
-             first_particle_inside
+             first_particle_inside, surface_normal
 
 contains
 
@@ -339,6 +339,19 @@ contains
       end if
    end function wall_distance
 
+   !> Unit normal (grid frame) of the wall's plane, or of a structure's surface at the grid-frame point x.
+   function surface_normal(wall, grid, x) result(n)
+      type(wall_t), intent(in) :: wall
+      type(grid_t), intent(in) :: grid
+      real(rp), intent(in) :: x(:)
+      real(rp) :: n(size(x))
+      if (wall%shaped) then
+         n = grid%frame%grid_vector(shape_normal(wall%shape, grid%frame%world_point(x), normal_step_in_cells * grid%h))
+      else
+         n = wall%normal(1:size(x))
+      end if
+   end function surface_normal
+
    !> Walls act during [active_from, active_until) only.
    pure subroutine set_wall_activity(walls, time)
       type(wall_t), intent(inout) :: walls(:)
@@ -449,8 +462,10 @@ contains
    !> its moment) that wall w gave the particles it corrected. With contact fields (all three or none):
    !> `field` (particle) the velocity field of each particle (0: the common one), `field_friction` (wall,
    !> field) the mu a structure applies to that field instead of its condition (< 0: its condition), and
-   !> field_impulse(:, w, f) gains the part of impulse(:, w) given to field f's particles.
-   subroutine keep_particles_inside(walls, grid, particles, corrections, impulse, field, field_friction, field_impulse)
+   !> field_impulse(:, w, f) gains the part of impulse(:, w) given to field f's particles. The particles of a
+   !> material with `skip(material)` are left alone: rigid bodies meet walls as bodies (rigid_bodies).
+   subroutine keep_particles_inside(walls, grid, particles, corrections, impulse, field, field_friction, field_impulse, &
+                                    skip)
       type(wall_t), intent(in) :: walls(:)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
@@ -459,10 +474,18 @@ contains
       integer, intent(in), optional :: field(:)
       real(rp), intent(in), optional :: field_friction(:, :)
       real(rp), intent(inout), optional :: field_impulse(:, :, :)
+      logical, intent(in), optional :: skip(:)
       integer :: w, p, d
       real(rp) :: distance, vn, lowest(3), highest(3), before(particles%dim)
+      logical, allocatable :: skipped(:)
       d = particles%dim
       if (.not. any(walls%active)) return
+      if (present(skip)) then
+         skipped = skip
+      else
+         allocate (skipped(max(1, maxval(particles%material(1:particles%count), 1))))
+         skipped = .false.
+      end if
       call position_bounds(particles, lowest, highest)
       do w = 1, size(walls)
          if (.not. walls(w)%active) cycle
@@ -470,10 +493,10 @@ contains
             ! no particle in the structure's box: skip the pass
             if (any(highest(1:d) < walls(w)%box_lower(1:d)) .or. any(lowest(1:d) > walls(w)%box_upper(1:d))) cycle
             if (present(field)) then
-               call keep_outside_structure(walls(w), grid, particles, corrections, impulse(:, w), field, &
+               call keep_outside_structure(walls(w), grid, particles, corrections, impulse(:, w), skipped, field, &
                                            field_friction(w, :), field_impulse(:, w, :))
             else
-               call keep_outside_structure(walls(w), grid, particles, corrections, impulse(:, w))
+               call keep_outside_structure(walls(w), grid, particles, corrections, impulse(:, w), skipped)
             end if
             cycle
          end if
@@ -483,13 +506,14 @@ contains
                if (walls(w)%normal(k) > 0.0_rp .and. lowest(k) - walls(w)%point(k) >= 0.0_rp) cycle
                if (walls(w)%normal(k) < 0.0_rp .and. highest(k) - walls(w)%point(k) <= 0.0_rp) cycle
             end associate
-            call keep_inside_axis_wall(walls(w), grid, particles, corrections, impulse(:, w))
+            call keep_inside_axis_wall(walls(w), grid, particles, corrections, impulse(:, w), skipped)
             cycle
          end if
          associate (n => walls(w)%normal(1:d), x0 => walls(w)%point(1:d))
             do p = 1, particles%count
                distance = dot_product(particles%x(:, p) - x0, n)
                if (distance >= 0.0_rp) cycle
+               if (skipped(particles%material(p))) cycle
                if (.not. behind_wall(walls(w), grid, particles%x(:, p), 0.0_rp)) cycle
                particles%x(:, p) = particles%x(:, p) - distance * n
                vn = dot_product(particles%v(:, p), n)
@@ -519,12 +543,13 @@ contains
    !> that round-off, which differs with the number of ranks. With `field` (particle), a particle of body
    !> field f > 0 meets Coulomb friction field_friction(f) if that is >= 0, and its impulse is also added
    !> to field_impulse(:, f).
-   subroutine keep_outside_structure(wall, grid, particles, corrections, impulse, field, field_friction, field_impulse)
+   subroutine keep_outside_structure(wall, grid, particles, corrections, impulse, skip, field, field_friction, field_impulse)
       type(wall_t), intent(in) :: wall
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
       integer, intent(inout) :: corrections
       real(rp), intent(inout) :: impulse(:)
+      logical, intent(in) :: skip(:)
       integer, intent(in), optional :: field(:)
       real(rp), intent(in), optional :: field_friction(:)
       real(rp), intent(inout), optional :: field_impulse(:, :)
@@ -539,6 +564,7 @@ contains
          world = grid%frame%world_point(particles%x(:, p))
          phi = shape_distance(wall%shape, world)
          if (phi >= -tolerance) cycle
+         if (skip(particles%material(p))) cycle
          n = grid%frame%grid_vector(shape_normal(wall%shape, world, step))
          particles%x(:, p) = particles%x(:, p) - phi * n
          if (dot_product(particles%v(:, p), n) < 0.0_rp) then
@@ -604,12 +630,13 @@ contains
    end subroutine position_bounds
 
    !> The safeguard for a wall normal to grid axis k: the same operation without the dot products.
-   subroutine keep_inside_axis_wall(wall, grid, particles, corrections, impulse)
+   subroutine keep_inside_axis_wall(wall, grid, particles, corrections, impulse, skip)
       type(wall_t), intent(in) :: wall
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
       integer, intent(inout) :: corrections
       real(rp), intent(inout) :: impulse(:)
+      logical, intent(in) :: skip(:)
       integer :: p, k
       real(rp) :: sense, x0, dp(particles%dim)
       k = wall%axis
@@ -617,6 +644,7 @@ contains
       x0 = wall%point(k)
       do p = 1, particles%count
          if (sense * (particles%x(k, p) - x0) >= 0.0_rp) cycle
+         if (skip(particles%material(p))) cycle
          if (.not. behind_wall(wall, grid, particles%x(:, p), 0.0_rp)) cycle
          particles%x(k, p) = x0
          if (sense * particles%v(k, p) < 0.0_rp) then

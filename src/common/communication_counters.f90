@@ -24,10 +24,11 @@ module communication_counters
    integer, parameter, public :: comm_diagnostics = 8    !< diagnostics rows (output times)
    integer, parameter, public :: comm_status = 9         !< status agreement and broadcast
    integer, parameter, public :: comm_other = 10         !< the solver's set-up
-   integer, parameter, public :: comm_categories = 10
+   integer, parameter, public :: comm_rigid = 11         !< rigid bodies: increments and contact points (rigid_bodies)
+   integer, parameter, public :: comm_categories = 11
    character(len=*), parameter :: names_(comm_categories) = [character(len=11) :: 'node_halo', 'cell_halo', &
                                                              'migration', 'balance', 'time_step', 'volume', &
-                                                             'records', 'diagnostics', 'status', 'other']
+                                                             'records', 'diagnostics', 'status', 'other', 'rigid']
    character(len=11), parameter, public :: comm_category_names(comm_categories) = names_
 
    !> Bytes of one element of the MPI types counted.

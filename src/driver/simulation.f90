@@ -301,6 +301,8 @@ contains
             speed = max(speed, speed_limit_factor * model%wave_speed(model%reference_density))
          end associate
       end do
+      ! only materials without waves (rigid bodies): no speed is a blow-up
+      if (speed == 0.0_rp) speed = huge(1.0_rp)
    end function blow_up_speed
 
    !> The densities taken as a blow-up [kg/m^3]: below the lightest material's reference density or above

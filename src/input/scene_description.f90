@@ -22,6 +22,7 @@ module scene_description
    !> Material model keywords (`&material model=`).
    character(len=*), parameter, public :: model_newtonian_fluid = 'newtonian_fluid'
    character(len=*), parameter, public :: model_linear_elastic = 'linear_elastic'
+   character(len=*), parameter, public :: model_rigid = 'rigid'   ! moves as one rigid body per &body
 
    !> `&run`: time stepping, update scheme and output control.
    type, public :: run_control_t
@@ -170,6 +171,8 @@ module scene_description
       character(len=16) :: points_checksum = ''
       integer :: particles_per_cell = 2       !< particles per cell per direction
       real(rp) :: velocity(3) = 0.0_rp        !< initial velocity [m/s]
+      !> initial angular velocity [rad/s] about the centre of the body's bounding box (2-D: component 3)
+      real(rp) :: angular_velocity(3) = 0.0_rp
       logical :: hydrostatic = .false.        !< start from the hydrostatic stress of a fluid at rest
       real(rp) :: free_surface_level = 0.0_rp !< height of the free surface along -gravity [m]
    end type body_spec_t

@@ -13,7 +13,7 @@ module scene_reader
    use error_status, only: status_t
    use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
                                 inlet_spec_t, gauge_spec_t, structure_spec_t, contact_spec_t, model_newtonian_fluid, &
-                                model_linear_elastic
+                                model_linear_elastic, model_rigid
    use shape_geometry, only: shape_t, max_vertices, no_vertex
    use namelist_scan, only: namelist_file_t, namelist_group_t, scan_namelist_file
    use scene_validation, only: validate_scene, resolve_scene, check_scene_memory, default_name, stabilization_keywords, &
@@ -140,6 +140,7 @@ module scene_reader
       variable_info_t('body', 'points_checksum', 'string', .false.), &
       variable_info_t('body', 'particles_per_cell', 'integer', .false.), &
       variable_info_t('body', 'velocity', 'real3', .false.), &
+      variable_info_t('body', 'angular_velocity', 'real3', .false.), &
       variable_info_t('body', 'hydrostatic', 'logical', .false.), &
       variable_info_t('body', 'free_surface_level', 'real', .false.), &
       variable_info_t('wall', 'point', 'real3', .true.), &
@@ -636,11 +637,31 @@ contains
                else if (material%model == model_linear_elastic .and. &
                         .not. file%groups(g)%assigns('youngs_modulus')) then
                   call status%fail(where//": variable youngs_modulus is required for model '"//model_linear_elastic//"'")
+               else if (material%model == model_rigid) then
+                  call refuse_constants(file%groups(g), where)
                end if
                if (.not. status%ok) return
             end associate
          end if
       end do
+
+   contains
+
+      !> A rigid material has no stiffness or viscosity: a constant given for it would be silently unused.
+      subroutine refuse_constants(group_text, where)
+         type(namelist_group_t), intent(in) :: group_text
+         character(len=*), intent(in) :: where
+         character(len=*), parameter :: constants(4) = [character(len=14) :: 'bulk_modulus', 'viscosity', &
+                                                        'youngs_modulus', 'poisson_ratio']
+         integer :: c
+         do c = 1, size(constants)
+            if (.not. group_text%assigns(trim(constants(c)))) cycle
+            call status%fail(where//': variable '//trim(constants(c))//" is not used by model '"//model_rigid// &
+                             "' (a rigid body has no elastic constants: remove it, or use model '"// &
+                             model_linear_elastic//"')")
+            return
+         end do
+      end subroutine refuse_constants
    end subroutine check_required_variables
 
    !> How many groups of the same name come before group `g`.
@@ -1080,13 +1101,13 @@ contains
       character(len=*), intent(inout) :: message
       character(len=*), intent(in) :: text
       character(len=text_len) :: name, material, shape, points_file, points_checksum
-      real(rp) :: lower(3), upper(3), velocity(3), free_surface_level, centre(3), size(3), rotation, &
-                  rotation_axis(3), radius, axis(3), length, vertices(2 * max_vertices), z_range(2)
+      real(rp) :: lower(3), upper(3), velocity(3), angular_velocity(3), free_surface_level, centre(3), size(3), &
+                  rotation, rotation_axis(3), radius, axis(3), length, vertices(2 * max_vertices), z_range(2)
       integer :: particles_per_cell
       logical :: hydrostatic
       namelist /body/ name, material, shape, lower, upper, centre, size, rotation, rotation_axis, radius, axis, &
-         length, vertices, z_range, points_file, points_checksum, particles_per_cell, velocity, hydrostatic, &
-         free_surface_level
+         length, vertices, z_range, points_file, points_checksum, particles_per_cell, velocity, angular_velocity, &
+         hydrostatic, free_surface_level
 
       name = spec%name
       material = spec%material
@@ -1098,6 +1119,7 @@ contains
       points_checksum = spec%points_checksum
       particles_per_cell = spec%particles_per_cell
       velocity = spec%velocity
+      angular_velocity = spec%angular_velocity
       hydrostatic = spec%hydrostatic
       free_surface_level = spec%free_surface_level
       read (text, nml=body, iostat=ios, iomsg=message)
@@ -1112,6 +1134,7 @@ contains
       call locals_to_shape(centre, size, rotation, rotation_axis, radius, axis, length, vertices, z_range, spec%shape)
       spec%particles_per_cell = particles_per_cell
       spec%velocity = velocity
+      spec%angular_velocity = angular_velocity
       spec%hydrostatic = hydrostatic
       spec%free_surface_level = free_surface_level
    end subroutine read_body_group

@@ -311,6 +311,8 @@ contains
             text = int_text(body%particles_per_cell)
          case ('velocity')
             text = reals(body%velocity)
+         case ('angular_velocity')
+            text = reals(body%angular_velocity)
          case ('hydrostatic')
             text = logical_text(body%hydrostatic)
          case ('free_surface_level')

@@ -9,7 +9,8 @@ module scene_validation
    use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
                                 inlet_spec_t, gauge_spec_t, contact_spec_t, structure_spec_t, opening_far_end, wall_none, &
                                 wall_slip, wall_no_slip, wall_friction, &
-                                model_newtonian_fluid, model_linear_elastic, gauge_pressure, gauge_level, gauge_velocity, &
+                                model_newtonian_fluid, model_linear_elastic, model_rigid, gauge_pressure, gauge_level, &
+                                gauge_velocity, &
                                 particle_field_names, field_precision_keywords
    use input_text, only: int_text, real_text, quoted_list, group_context, ordinal
    use memory_budget, only: memory_budget_t, byte_text
@@ -60,7 +61,7 @@ module scene_validation
                                                                         wall_friction]
    !> Accepted `&material model=` keywords (stored lower case).
    character(len=*), parameter, public :: model_keywords(*) = &
-      [character(len=15) :: model_newtonian_fluid, model_linear_elastic]
+      [character(len=15) :: model_newtonian_fluid, model_linear_elastic, model_rigid]
    !> Accepted `&gauge kind=` keywords (stored lower case).
    character(len=*), parameter, public :: gauge_kind_keywords(*) = &
       [character(len=8) :: gauge_pressure, gauge_level, gauge_velocity]
@@ -759,6 +760,9 @@ contains
          if (all(material%stabilization /= stabilization_keywords)) then
             call status%fail(where//': variable stabilization must be one of '//quoted_list(stabilization_keywords)// &
                              ", got '"//trim(material%stabilization)//"'")
+         else if (material%model == model_rigid .and. material%stabilization /= 'none') then
+            call status%fail(where//": variable stabilization must be 'none' for model '"//model_rigid// &
+                             "' (a rigid body has no strain to filter), got '"//trim(material%stabilization)//"'")
          end if
          if (all(material%oscillation_rule /= oscillation_rule_keywords)) then
             call status%fail(where//': variable oscillation_rule must be one of '// &
@@ -819,6 +823,14 @@ contains
          call check_real(where, 'upper('//int_text(k)//')', body%upper(k), status)
          call check_real(where, 'velocity('//int_text(k)//')', body%velocity(k), status)
       end do
+      do k = 1, 3
+         call check_real(where, 'angular_velocity('//int_text(k)//')', body%angular_velocity(k), status)
+      end do
+      if (status%ok .and. grid%dim == 2 .and. any(body%angular_velocity(1:2) /= 0.0_rp)) then
+         call status%fail(where//': variable angular_velocity turns a 2-D body about z only: give 0.0, 0.0, '// &
+                          'omega_z, got '//real_text(body%angular_velocity(1))//', '//real_text(body%angular_velocity(2)))
+         return
+      end if
       call check_real(where, 'free_surface_level', body%free_surface_level, status)
       call check_shape_reals(where, body%shape, status)
       if (.not. status%ok) return
@@ -1442,6 +1454,13 @@ contains
                end do
                call status%fail(where//': variable between must name declared &material or &structure groups ('// &
                                 quoted_list(declared)//"), got '"//trim(contact%between(k))//"'")
+               return
+            end if
+            if (materials(m)%model == model_rigid) then
+               call status%fail(where//": variable between names the rigid material '"//trim(contact%between(k))// &
+                                "': contact of rigid bodies through &contact is not implemented yet (a rigid body "// &
+                                'meets walls and structures as a body, and the fluid and other solids through the '// &
+                                'common velocity field: docs/theory.md section 3.6)')
                return
             end if
             if (materials(m)%model == model_newtonian_fluid) then

@@ -26,6 +26,7 @@ module checkpoint
    use error_status, only: status_t
    use scene_description, only: scene_t
    use mpm_solver, only: solver_t
+   use rigid_bodies, only: rigid_state_width
    use domain_decomposition, only: valid_layout
    use world_frame, only: frame_t, place_grid
    use particle_sorting, only: update_cells
@@ -514,6 +515,8 @@ contains
                                                             [size(solver%bodies%previous_momentum)]), status)
          call file%write_attribute('body_angle', solver%bodies%previous_angle, status)
       end if
+      ! the rigid bodies' state (the same on every rank): mass, inertia, centre, motion, rotation
+      if (solver%rigid%active) call file%write_attribute('rigid_bodies', solver%rigid%state(), status)
       if (size(solver%loads%impulse) > 0) then
          call file%write_slab('ranks/load_impulse', distributed_slab(solver%domain%comm, 1), &
                               reshape(solver%loads%impulse, [size(solver%loads%impulse), 1]), status)
@@ -552,6 +555,12 @@ contains
          call file%read_attribute('body_momentum', flat, status)
          if (status%ok) solver%bodies%previous_momentum = reshape(flat, shape(solver%bodies%previous_momentum))
          call file%read_attribute('body_angle', solver%bodies%previous_angle, status)
+      end if
+      if (solver%rigid%active) then
+         if (allocated(flat)) deallocate (flat)
+         allocate (flat(rigid_state_width * size(solver%rigid%bodies)))
+         call file%read_attribute('rigid_bodies', flat, status)
+         if (status%ok) call solver%rigid%set_state(flat)
       end if
    end subroutine read_series_state
 

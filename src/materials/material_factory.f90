@@ -1,10 +1,11 @@
 !> Builds the constitutive model of each declared material (`&material model=`).
 module material_factory
    use error_status, only: status_t
-   use scene_description, only: material_spec_t, model_newtonian_fluid, model_linear_elastic
+   use scene_description, only: material_spec_t, model_newtonian_fluid, model_linear_elastic, model_rigid
    use material_model, only: material_slot_t
    use newtonian_fluid, only: newtonian_fluid_t
    use linear_elastic, only: linear_elastic_t
+   use rigid_material, only: rigid_material_t
    implicit none
    private
 
@@ -18,6 +19,7 @@ contains
       type(status_t), intent(inout) :: status
       type(newtonian_fluid_t) :: fluid
       type(linear_elastic_t) :: solid
+      type(rigid_material_t) :: rigid
       integer :: m
 
       allocate (materials(size(specs)))
@@ -37,6 +39,11 @@ contains
             solid%uses_spin = .true.       ! the Jaumann rate
             call solid%set_from_young_poisson(specs(m)%youngs_modulus, specs(m)%poisson_ratio)
             allocate (materials(m)%model, source=solid)
+         case (model_rigid)
+            rigid%name = specs(m)%name
+            rigid%reference_density = specs(m)%density
+            rigid%is_fluid = .false.
+            allocate (materials(m)%model, source=rigid)
          case default
             call status%fail('material '//trim(specs(m)%name)//': unknown model '//trim(specs(m)%model))
             return

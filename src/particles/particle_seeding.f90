@@ -13,7 +13,8 @@ module particle_seeding
    use kinds, only: rp, i8
    use input_text, only: int_text
    use scene_description, only: scene_t, relaxes_to_eos
-   use body_lattice, only: body_lattice_t, body_lattice_of, lattice_point, lattice_keeps, has_points_file, body_id_count
+   use body_lattice, only: body_lattice_t, body_lattice_of, lattice_point, lattice_keeps, has_points_file, body_id_count, &
+                           body_bounds
    use tensor_layout, only: n_components
    use background_grid, only: grid_t
    use domain_decomposition, only: domain_t
@@ -35,7 +36,7 @@ contains
       type(particle_set_t), intent(inout) :: particles
       integer :: b, dim, c(3), pass
       integer(i8) :: id_offset, owned, k, points
-      real(rp) :: x(3), up(3), g_norm, density, x_grid(3), v_grid(3), volume
+      real(rp) :: x(3), up(3), g_norm, density, x_grid(3), v_grid(3), volume, centre(3), lo(3), hi(3)
       logical :: eos_state, from_file
       type(body_lattice_t) :: lattice
       real(rp), allocatable :: sbar(:)
@@ -69,6 +70,9 @@ contains
                eos_state = relaxes_to_eos(scene%materials(body%material_index))
                v_grid = 0.0_rp
                v_grid(1:dim) = grid%frame%grid_vector(body%velocity(1:dim))
+               ! a spinning body: v = v0 + omega x (x - centre) about the centre of its bounding box
+               call body_bounds(scene, b, lo, hi)
+               centre = 0.5_rp * (lo + hi)
                x_grid = 0.0_rp
                x = 0.0_rp
                do k = 0, points - 1
@@ -88,6 +92,8 @@ contains
                      owned = owned + 1
                      cycle
                   end if
+                  if (any(body%angular_velocity /= 0.0_rp)) v_grid(1:dim) = &
+                     grid%frame%grid_vector(body%velocity(1:dim) + spin_velocity(body%angular_velocity, x - centre, dim))
                   call add_particle(x, volume)
                end do
                id_offset = id_offset + points
@@ -115,4 +121,16 @@ contains
          end associate
       end subroutine add_particle
    end subroutine seed_bodies
+
+   !> omega x r (world frame), its first dim components (2-D: omega_z (-r_y, r_x)).
+   pure function spin_velocity(omega, r, dim) result(v)
+      real(rp), intent(in) :: omega(3), r(3)
+      integer, intent(in) :: dim
+      real(rp) :: v(dim)
+      if (dim == 2) then
+         v = omega(3) * [-r(2), r(1)]
+      else
+         v = [omega(2) * r(3) - omega(3) * r(2), omega(3) * r(1) - omega(1) * r(3), omega(1) * r(2) - omega(2) * r(1)]
+      end if
+   end function spin_velocity
 end module particle_seeding

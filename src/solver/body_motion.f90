@@ -23,6 +23,7 @@ module body_motion
    use particle_set, only: particle_set_t
    use body_lattice, only: body_lattice_t, body_lattice_of, lattice_point, has_points_file, body_id_count, body_bounds
    use world_frame, only: frame_t
+   use small_matrices, only: identity
    implicit none
    private
 
@@ -61,6 +62,7 @@ module body_motion
       procedure :: row_values => bodies_row_values
       procedure :: column_names => bodies_column_names
       procedure :: count => bodies_count
+      procedure :: reference => bodies_reference
    end type body_motion_t
 
 contains
@@ -115,6 +117,16 @@ contains
       bodies_count = 0
       if (allocated(self%bodies)) bodies_count = size(self%bodies)
    end function bodies_count
+
+   !> Grid-frame reference position of the particle with index k (0-based) in tracked body b.
+   pure function bodies_reference(self, b, k, frame) result(x)
+      class(body_motion_t), intent(in) :: self
+      integer, intent(in) :: b
+      integer(i8), intent(in) :: k
+      type(frame_t), intent(in) :: frame
+      real(rp) :: x(self%dim)
+      x = reference_position(self%bodies(b), k, frame, self%dim)
+   end function bodies_reference
 
    !> Grid-frame reference position of the particle with index k (0-based) in the body: where
    !> seed_bodies put it.
@@ -325,14 +337,6 @@ contains
                     m(1, 3) * (m(2, 1) * m(3, 2) - m(2, 2) * m(3, 1))
    end function determinant
 
-   pure function identity() result(r)
-      real(rp) :: r(3, 3)
-      integer :: i
-      r = 0.0_rp
-      do i = 1, 3
-         r(i, i) = 1.0_rp
-      end do
-   end function identity
 
    !> The rotation vector theta n of a rotation matrix (0 <= theta <= pi).
    pure function rotation_vector(r) result(w)

@@ -43,6 +43,7 @@ module mpm_solver
    use fluid_gauges, only: fluid_gauges_t
    use body_motion, only: body_motion_t
    use body_contact, only: contact_t, contact_field_rows
+   use rigid_bodies, only: rigid_set_t
    use world_frame, only: frame_t, place_grid
    use grid_transfer, only: particles_to_grid, update_velocity_and_remap, grid_to_particles
    use run_diagnostics, only: diagnostics_t, compute_diagnostics
@@ -81,6 +82,7 @@ module mpm_solver
       type(fluid_gauges_t) :: gauges            !< the &gauge sensors (gauges.csv)
       type(body_motion_t) :: bodies             !< the solid bodies (bodies.csv)
       type(contact_t) :: contact                !< velocity fields of the bodies in contact (&contact)
+      type(rigid_set_t) :: rigid                !< the rigid bodies (&material model = 'rigid')
       real(rp) :: time = 0.0_rp, dt = 0.0_rp
       integer(i8) :: step = 0
       integer :: lost_particles = 0             !< local count of particles that left the grid
@@ -178,6 +180,8 @@ contains
       call update_cells(self%grid, self%particles)
       call sort_by_material_and_cell(self%grid, self%particles)
       call size_node_arrays(self)
+      ! the rigid bodies' mass, inertia and motion from their particles (a restart reads them)
+      call self%rigid%init(scene, self%bodies, self%grid, self%particles, self%domain%comm, measure=seed)
 
       ! a node is "empty" below a millionth of a millionth of the lightest particle
       ! (of the particles the bodies and the inlets make: a scene may start empty and fill through an inlet)
@@ -429,6 +433,7 @@ contains
       call sum_shared_nodes(self%domain, self%grid, self%grid%accumulated)
       call self%timers%switch_to(phase_grid_update)
       call update_nodes(self, dt)
+      if (self%rigid%active) call solve_rigid_bodies(self, dt)
 
       call self%timers%switch_to(phase_stabilization)
       do m = 1, size(self%schemes)
@@ -440,6 +445,7 @@ contains
       call self%timers%switch_to(phase_grid_to_particles)
       if (self%musl) call remap_velocities(self)
       call move_particles(self, dt)
+      if (self%rigid%active) call self%rigid%finish()
       if (self%volume%shifting_now) then
          ! the shifts come after the extent was taken: widen it by their largest length
          self%extent(:, 1) = self%extent(:, 1) - max_shift_in_cells * self%grid%h
@@ -477,9 +483,10 @@ contains
       if (self%contact%active) then
          call keep_particles_inside(self%walls, self%grid, self%particles, self%wall_corrections, self%loads%step_impulse, &
                                     self%contact%particle_field, self%contact%wall_friction(size(self%walls)), &
-                                    self%loads%field_impulse)
+                                    self%loads%field_impulse, skip=self%rigid%rigid_material)
       else
-         call keep_particles_inside(self%walls, self%grid, self%particles, self%wall_corrections, self%loads%step_impulse)
+         call keep_particles_inside(self%walls, self%grid, self%particles, self%wall_corrections, &
+                                    self%loads%step_impulse, skip=self%rigid%rigid_material)
       end if
       call self%timers%switch_to(phase_loads)
       call self%loads%end_step(self%walls)
@@ -565,6 +572,16 @@ contains
       end associate
    end subroutine update_nodes
 
+   !> The rigid bodies' step (rigid_bodies): each moves with the rigid projection of the nodal increments of
+   !> its nodes and the walls' contact; the impulses the walls give them count in the loads on rank 0.
+   !> Without &contact (scene_validation refuses a rigid material in one). Collective.
+   subroutine solve_rigid_bodies(self, dt)
+      type(solver_t), intent(inout) :: self
+      real(rp), intent(in) :: dt
+      call self%rigid%solve(self%domain, self%grid, self%particles, self%walls, dt, self%domain%rank == 0, &
+                            self%loads%step_impulse)
+   end subroutine solve_rigid_bodies
+
    !> MUSL: update the particle velocities, then nodal velocities from their momentum, with walls.
    subroutine remap_velocities(self)
       type(solver_t), intent(inout) :: self
@@ -581,6 +598,7 @@ contains
          return
       end if
       call update_velocity_and_remap(self%grid, self%particles, self%run%flip_fraction, self%remapped_momentum)
+      if (self%rigid%active) call self%rigid%remap_correction(self%grid, self%particles, self%remapped_momentum)
       call self%timers%switch_to(phase_halo)
       call sum_shared_nodes(self%domain, self%grid, self%remapped_momentum)
       call self%timers%switch_to(phase_grid_to_particles)
@@ -625,6 +643,14 @@ contains
          last = self%particles%material_last(m)
          if (last < first) cycle
          uses_spin = self%materials(m)%model%uses_spin
+         if (self%rigid%active) then
+            if (self%rigid%rigid_material(m)) then
+               ! rigid bodies move as wholes (rigid_bodies): no G2P, no stress
+               call self%rigid%move(self%bodies, self%grid, self%particles, first, last, self%extent(1:dim, 1), &
+                                    self%extent(1:dim, 2))
+               cycle
+            end if
+         end if
          if (allocated(self%schemes(m)%scheme)) then
             call particle_kinematics(first, last, self%particles%strain_rate(:, first:last), &
                                      self%particles%spin(:, first:last))
@@ -755,6 +781,8 @@ contains
          end associate
       end do
       if (speed > 0.0_rp) dt = self%run%cfl * self%grid%h / (sqrt(real(self%grid%dim, rp)) * speed)
+      ! a body without waves (rigid) at rest: falling from rest it moves g dt^2 / 2 <= cfl h in the step
+      if (any(self%gravity /= 0.0_rp)) dt = min(dt, sqrt(2.0_rp * self%run%cfl * self%grid%h / norm2(self%gravity)))
       dt = min(dt, viscous_time_step(self))
    end subroutine time_step_of_speeds
 

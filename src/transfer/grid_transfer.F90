@@ -15,7 +15,7 @@ module grid_transfer
    private
 
    public :: particles_to_grid, update_velocity_and_remap, grid_to_particles, volume_to_grid, gradient_at_particles, &
-             node_offsets
+             node_offsets, spread_to_grid, mass_to_grid
 
    !> The kernel instances: shape function and dimension; APIC's are these + apic.
    integer, parameter :: kernels_linear_2d = 1, kernels_linear_3d = 2, kernels_bspline2_2d = 3, kernels_bspline2_3d = 4
@@ -289,6 +289,37 @@ contains
       end select
    end subroutine gradient_at_particles
 
+   !> nodal(1:dim, i) += sum_p N_i(x_p) m_p (u_p + B_p (x_i - x_p)) over p = first..last, u_p = values(1:dim, q),
+   !> B_p = values(dim + 1:, q) column by column if given (q = p - first + 1); a particle with row_offset(q) =
+   !> o > 0 also adds to rows o + 1:o + dim (its contact field).
+   subroutine spread_to_grid(grid, particles, first, last, values, row_offset, nodal)
+      type(grid_t), intent(in) :: grid
+      type(particle_set_t), intent(in) :: particles
+      integer, intent(in) :: first, last, row_offset(:)
+      real(rp), intent(in) :: values(:, :)
+      real(rp), intent(inout) :: nodal(:, :)
+      select case (instance(grid))
+      case (kernels_linear_2d); call spread_to_grid_2d(grid, particles, first, last, values, row_offset, nodal)
+      case (kernels_linear_3d); call spread_to_grid_3d(grid, particles, first, last, values, row_offset, nodal)
+      case (kernels_bspline2_2d); call spread_to_grid_b2_2d(grid, particles, first, last, values, row_offset, nodal)
+      case default; call spread_to_grid_b2_3d(grid, particles, first, last, values, row_offset, nodal)
+      end select
+   end subroutine spread_to_grid
+
+   !> nodal(row(q), i) += sum_p N_i(x_p) m_p over p = first..last (q = p - first + 1; row 0: skipped).
+   subroutine mass_to_grid(grid, particles, first, last, row, nodal)
+      type(grid_t), intent(in) :: grid
+      type(particle_set_t), intent(in) :: particles
+      integer, intent(in) :: first, last, row(:)
+      real(rp), intent(inout) :: nodal(:, :)
+      select case (instance(grid))
+      case (kernels_linear_2d); call mass_to_grid_2d(grid, particles, first, last, row, nodal)
+      case (kernels_linear_3d); call mass_to_grid_3d(grid, particles, first, last, row, nodal)
+      case (kernels_bspline2_2d); call mass_to_grid_b2_2d(grid, particles, first, last, row, nodal)
+      case default; call mass_to_grid_b2_3d(grid, particles, first, last, row, nodal)
+      end select
+   end subroutine mass_to_grid
+
 ! APIC's C_p = B_p D_p^-1 = sum_a v_a (x) D_p^-1 (x_a - x_p) N_a (Jiang et al. 2015), per instance the term
 ! AFFINE_GRADIENT(j, a) = [D_p^-1 (x_a - x_p) N_a]_j: for multilinear functions it is grad N_a exactly, also
 ! on the grid lines where D_p is singular; for quadratic B-splines D_p = h^2/4 I at every position, so it
@@ -307,6 +338,8 @@ contains
 #define G2P grid_to_particles_2d
 #define V2G volume_to_grid_2d
 #define GRAD2P gradient_at_particles_2d
+#define SPREAD2G spread_to_grid_2d
+#define MASS2G mass_to_grid_2d
 #include "../grid/multilinear_shape.inc"
 #include "grid_transfer_kernels.inc"
 #include "grid_transfer_undef.inc"
@@ -318,6 +351,8 @@ contains
 #define G2P grid_to_particles_3d
 #define V2G volume_to_grid_3d
 #define GRAD2P gradient_at_particles_3d
+#define SPREAD2G spread_to_grid_3d
+#define MASS2G mass_to_grid_3d
 #include "../grid/multilinear_shape.inc"
 #include "grid_transfer_kernels.inc"
 #include "grid_transfer_undef.inc"
@@ -329,6 +364,8 @@ contains
 #define G2P grid_to_particles_b2_2d
 #define V2G volume_to_grid_b2_2d
 #define GRAD2P gradient_at_particles_b2_2d
+#define SPREAD2G spread_to_grid_b2_2d
+#define MASS2G mass_to_grid_b2_2d
 #include "../grid/bspline2_shape.inc"
 #include "grid_transfer_kernels.inc"
 #include "grid_transfer_undef.inc"
@@ -340,6 +377,8 @@ contains
 #define G2P grid_to_particles_b2_3d
 #define V2G volume_to_grid_b2_3d
 #define GRAD2P gradient_at_particles_b2_3d
+#define SPREAD2G spread_to_grid_b2_3d
+#define MASS2G mass_to_grid_b2_3d
 #include "../grid/bspline2_shape.inc"
 #include "grid_transfer_kernels.inc"
 #include "grid_transfer_undef.inc"
