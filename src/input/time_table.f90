@@ -19,6 +19,7 @@ module time_table
       character(len=name_len), allocatable :: columns(:)    !< the value columns' names, in the order asked for
       real(rp), allocatable :: time(:)                      !< (n), strictly increasing [s]
       real(rp), allocatable :: values(:, :)                 !< (size(columns), n)
+      integer, allocatable :: line(:)                       !< (n) the line of each row in the file (messages)
    contains
       procedure :: value_at => table_value_at
       procedure :: rate_at => table_rate_at
@@ -79,6 +80,7 @@ contains
       table%columns = names(2:)
       table%time = rows(1, :)
       table%values = rows(2:, :)
+      table%line = line
       table%checksum = numbers_checksum(rows)
    end subroutine read_time_table
 
