@@ -22,7 +22,7 @@ import h5py
 import numpy as np
 import pandas as pd
 
-from flotsam_run import Checks, Flotsam, csv_data_lines, main_arguments
+from flotsam_run import Checks, Flotsam, checkpoint_at_step, csv_data_lines, main_arguments
 
 RHO = 1000.0
 CELL = 0.05
@@ -100,12 +100,7 @@ def check_restart(checks, flotsam, reference):
     if not checks.check(result.returncode == 0, "restart: the hydrograph run stopped at step 560",
                         result.stderr[-2000:]):
         return
-    checkpoint = None
-    for path in glob.glob(flotsam.path("height_split", "checkpoints", "checkpoint_*.h5")):
-        with h5py.File(path) as f:
-            if int(f.attrs["step"]) == 500:
-                checkpoint = os.path.relpath(path, flotsam.workdir)
-                time = float(f.attrs["time"])
+    checkpoint, time = checkpoint_at_step(flotsam, "height_split", 500)
     if not checks.check(checkpoint is not None, "restart: a checkpoint at step 500"):
         return
     checks.check(time < 0.6, f"restart: the checkpoint (t = {time:.4f} s) lies before the breakpoints at 0.6 and 0.61 s")
