@@ -71,6 +71,7 @@ contains
       if (rank /= root) call resize(bytes, n)
       call MPI_Bcast(bytes, n, MPI_CHARACTER, root, comm)
       call broadcast_body_points(scene, counts(2), comm, root, rank)
+      call broadcast_inlet_tables(scene, counts(4), comm, root, rank)
       if (rank == root) return
 
       at = 1
@@ -136,6 +137,43 @@ contains
          end associate
       end do
    end subroutine broadcast_body_points
+
+   !> The time tables of the inlets (scene%inlet_tables): per inlet the numbers of columns and rows
+   !> (-1: no table), then path, checksum, column names, times, values and lines.
+   subroutine broadcast_inlet_tables(scene, inlets, comm, root, rank)
+      type(scene_t), intent(inout) :: scene
+      integer, intent(in) :: inlets, root, rank
+      type(MPI_Comm), intent(in) :: comm
+      integer :: i, shape(2)
+      logical :: has_tables
+      if (inlets < 0) return
+      has_tables = allocated(scene%inlet_tables)
+      call MPI_Bcast(has_tables, 1, MPI_LOGICAL, root, comm)
+      if (.not. has_tables) then
+         if (allocated(scene%inlet_tables)) deallocate (scene%inlet_tables)
+         return
+      end if
+      if (rank /= root) then
+         if (allocated(scene%inlet_tables)) deallocate (scene%inlet_tables)
+         allocate (scene%inlet_tables(inlets))
+      end if
+      do i = 1, inlets
+         associate (table => scene%inlet_tables(i))
+            shape = -1
+            if (rank == root .and. allocated(table%time)) shape = [size(table%values, 1), size(table%time)]
+            call MPI_Bcast(shape, 2, MPI_INTEGER, root, comm)
+            if (shape(1) < 0) cycle
+            if (rank /= root) allocate (table%columns(shape(1)), table%time(shape(2)), table%values(shape(1), shape(2)), &
+                                        table%line(shape(2)))
+            call MPI_Bcast(table%path, len(table%path), MPI_CHARACTER, root, comm)
+            call MPI_Bcast(table%checksum, len(table%checksum), MPI_CHARACTER, root, comm)
+            call MPI_Bcast(table%columns, len(table%columns) * shape(1), MPI_CHARACTER, root, comm)
+            call MPI_Bcast(table%time, shape(2), MPI_DOUBLE_PRECISION, root, comm)
+            call MPI_Bcast(table%values, size(table%values), MPI_DOUBLE_PRECISION, root, comm)
+            call MPI_Bcast(table%line, shape(2), MPI_INTEGER, root, comm)
+         end associate
+      end do
+   end subroutine broadcast_inlet_tables
 
    !> Allocate `bytes` with `n` elements (assigning to an unallocated array first makes gfortran 12
    !> warn falsely about uninitialised bounds).

@@ -3,6 +3,7 @@
 module scene_description
    use kinds, only: rp, i8, path_len, name_len
    use shape_geometry, only: shape_t
+   use time_table, only: time_table_t
    implicit none
    private
 
@@ -111,7 +112,8 @@ module scene_description
       real(rp) :: moment_point(3) = huge(1.0_rp)
    end type structure_spec_t
 
-   !> `&inlet`: an opening through which fluid enters at a constant speed (algorithms.md section 4.3).
+   !> `&inlet`: an opening through which fluid enters at a constant speed, or at the speed (and height) of
+   !> a time table `velocity_file` (a hydrograph; algorithms.md section 4.3).
    !> The opening lies in the plane through `point` normal to `direction` (the flow direction, world
    !> frame); it spans `height` along t = (-d_y, d_x, 0) from `point` and, in 3-D, `width` along z.
    type, public :: inlet_spec_t
@@ -122,14 +124,19 @@ module scene_description
       real(rp) :: direction(3) = 0.0_rp       !< flow direction (made unit when resolved)
       real(rp) :: height = 0.0_rp             !< size of the opening along t [m] (H of rho v H)
       real(rp) :: width = 0.0_rp              !< 3-D: size of the opening along z [m]
-      real(rp) :: velocity = 0.0_rp           !< inflow speed v0 [m/s]
+      real(rp) :: velocity = 0.0_rp           !< inflow speed v0 [m/s]; 0: not given (velocity_file)
+      !> a time table (t, velocity[, height]) of the inflow; '' none. Resolved: the absolute path
+      character(len=path_len) :: velocity_file = ''
+      character(len=16) :: velocity_checksum = ''   !< time_table checksum of the table's numbers ('' not given)
+      !> the fluid enters with the table's column `height` (<= height, the opening's size) instead of height
+      logical :: height_from_file = .false.
       real(rp) :: start_time = 0.0_rp         !< the inlet opens [s]
       real(rp) :: end_time = huge(1.0_rp)     !< the inlet closes and acts as a wall [s]
       integer :: particles_per_cell = 2       !< particles per cell per direction
       logical :: hydrostatic = .false.        !< new particles carry the hydrostatic pressure below the stream top
    end type inlet_spec_t
 
-   public :: opening_tangent, opening_far_end, shifts_particles, relaxes_to_eos, writes_particle_field
+   public :: opening_tangent, opening_far_end, has_velocity_file, shifts_particles, relaxes_to_eos, writes_particle_field
 
    !> `&material`: one constitutive model and its parameters.
    type, public :: material_spec_t
@@ -221,6 +228,8 @@ module scene_description
       type(wall_spec_t), allocatable :: walls(:)      !< `&wall` groups (the `&box_walls` sides are in grid)
       type(structure_spec_t), allocatable :: structures(:)   !< `&structure` groups
       type(inlet_spec_t), allocatable :: inlets(:)
+      !> per inlet, the table of its velocity_file (read by rank 0, broadcast with the scene; no rows: none)
+      type(time_table_t), allocatable :: inlet_tables(:)
       type(gauge_spec_t), allocatable :: gauges(:)
       type(contact_spec_t), allocatable :: contacts(:)
    end type scene_t
@@ -262,6 +271,12 @@ contains
          start = start + comma
       end do
    end function writes_particle_field
+
+   !> The inlet's speed (and height) follow the time table of its velocity_file.
+   pure logical function has_velocity_file(inlet)
+      type(inlet_spec_t), intent(in) :: inlet
+      has_velocity_file = len_trim(inlet%velocity_file) > 0
+   end function has_velocity_file
 
    !> The in-plane direction along which an inlet's `height` runs: t = (-d_y, d_x, 0), d the unit
    !> flow direction.

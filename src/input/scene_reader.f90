@@ -22,6 +22,7 @@ module scene_reader
    use status_broadcast, only: broadcast_status
    use input_text, only: lower_case, upper_case, int_text, ordinal, group_context, canonical_keyword
    use point_file, only: load_body_points
+   use inlet_table, only: load_inlet_tables
    implicit none
    private
 
@@ -157,7 +158,10 @@ module scene_reader
       variable_info_t('inlet', 'direction', 'real3', .true.), &
       variable_info_t('inlet', 'height', 'real', .true.), &
       variable_info_t('inlet', 'width', 'real', .false.), &
-      variable_info_t('inlet', 'velocity', 'real', .true.), &
+      variable_info_t('inlet', 'velocity', 'real', .false.), &
+      variable_info_t('inlet', 'velocity_file', 'string', .false.), &
+      variable_info_t('inlet', 'velocity_checksum', 'string', .false.), &
+      variable_info_t('inlet', 'height_from_file', 'logical', .false.), &
       variable_info_t('inlet', 'start_time', 'real', .false.), &
       variable_info_t('inlet', 'end_time', 'real', .false.), &
       variable_info_t('inlet', 'particles_per_cell', 'integer', .false.), &
@@ -229,6 +233,7 @@ contains
          if (status%ok) call validate_scene(scene, label, status)
          ! the points of `&body points_file` (checked like the scene's values, before any output)
          if (status%ok) call load_body_points(scene, label, status)
+         if (status%ok) call load_inlet_tables(scene, label, status)
          if (status%ok) call resolve_scene(scene)
          ! before any particle is made: a scene too large for the machine is refused, not run out of memory
          if (status%ok) call check_scene_memory(scene, label, ranks, budget, status)
@@ -1247,12 +1252,12 @@ contains
       integer, intent(out) :: ios
       character(len=*), intent(inout) :: message
       character(len=*), intent(in) :: text
-      character(len=text_len) :: name, material
+      character(len=text_len) :: name, material, velocity_file, velocity_checksum
       real(rp) :: point(3), direction(3), height, width, velocity, start_time, end_time
       integer :: particles_per_cell
-      logical :: hydrostatic
-      namelist /inlet/ name, material, point, direction, height, width, velocity, start_time, end_time, &
-         particles_per_cell, hydrostatic
+      logical :: hydrostatic, height_from_file
+      namelist /inlet/ name, material, point, direction, height, width, velocity, velocity_file, velocity_checksum, &
+         height_from_file, start_time, end_time, particles_per_cell, hydrostatic
 
       name = spec%name
       material = spec%material
@@ -1261,6 +1266,9 @@ contains
       height = spec%height
       width = spec%width
       velocity = spec%velocity
+      velocity_file = spec%velocity_file
+      velocity_checksum = spec%velocity_checksum
+      height_from_file = spec%height_from_file
       start_time = spec%start_time
       end_time = spec%end_time
       particles_per_cell = spec%particles_per_cell
@@ -1268,12 +1276,15 @@ contains
       read (text, nml=inlet, iostat=ios, iomsg=message)
       call take_text('name', name, spec%name, ios, message)
       call take_text('material', material, spec%material, ios, message)
+      call take_text('velocity_file', velocity_file, spec%velocity_file, ios, message)
+      call take_text('velocity_checksum', velocity_checksum, spec%velocity_checksum, ios, message, fold='lower')
       if (ios /= 0) return
       spec%point = point
       spec%direction = direction
       spec%height = height
       spec%width = width
       spec%velocity = velocity
+      spec%height_from_file = height_from_file
       spec%start_time = start_time
       spec%end_time = end_time
       spec%particles_per_cell = particles_per_cell

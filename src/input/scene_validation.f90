@@ -8,6 +8,7 @@ module scene_validation
    use error_status, only: status_t
    use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
                                 inlet_spec_t, gauge_spec_t, contact_spec_t, structure_spec_t, opening_far_end, wall_none, &
+                                has_velocity_file, &
                                 wall_slip, wall_no_slip, wall_friction, &
                                 model_newtonian_fluid, model_linear_elastic, model_rigid, gauge_pressure, gauge_level, &
                                 gauge_velocity, &
@@ -168,6 +169,7 @@ contains
       type(scene_t), intent(in) :: scene
       integer, intent(in) :: b
       real(rp) :: spacing, length
+      real(rp), allocatable :: area(:)
       integer :: dim
       logical :: exact
       dim = scene%grid%dim
@@ -178,6 +180,14 @@ contains
          associate (inlet => scene%inlets(-b))
             spacing = scene%grid%cell_size / inlet%particles_per_cell
             length = inlet%velocity * max(0.0_rp, min(scene%run%end_time, inlet%end_time) - inlet%start_time)
+            if (has_velocity_file(inlet) .and. allocated(scene%inlet_tables)) then
+               ! the table's L(t) = integral of v dt (its first column)
+               if (allocated(scene%inlet_tables(-b)%time)) then
+                  area = scene%inlet_tables(-b)%integral(inlet%start_time, &
+                                                         max(inlet%start_time, min(scene%run%end_time, inlet%end_time)))
+                  length = area(1)
+               end if
+            end if
             n = aint(length / spacing) * max(1.0_rp, anint(inlet%height / spacing))
             if (dim == 3) n = n * max(1.0_rp, anint(inlet%width / spacing))
          end associate
@@ -1320,7 +1330,28 @@ contains
       end do
       call check_real(where, 'height', inlet%height, status, greater_than=0.0_rp)
       if (dim == 3) call check_real(where, 'width', inlet%width, status, greater_than=0.0_rp)
-      call check_real(where, 'velocity', inlet%velocity, status, greater_than=0.0_rp)
+      if (has_velocity_file(inlet)) then
+         ! velocity = 0 is the default: a scene record writes it beside the file
+         if (abs(inlet%velocity) > 0.0_rp) then
+            call status%fail(where//': variables velocity and velocity_file exclude each other: give a constant '// &
+                             'speed or a time table of it, not both')
+            return
+         end if
+      else
+         if (len_trim(inlet%velocity_checksum) > 0) then
+            call status%fail(where//': variable velocity_checksum belongs to velocity_file, which is not given')
+            return
+         else if (inlet%height_from_file) then
+            call status%fail(where//': variable height_from_file needs velocity_file (a time table with a column '// &
+                             'height)')
+            return
+         else if (abs(inlet%velocity) == 0.0_rp) then
+            call status%fail(where//': give variable velocity (a constant inflow speed > 0) or velocity_file (a '// &
+                             'time table of t and velocity)')
+            return
+         end if
+         call check_real(where, 'velocity', inlet%velocity, status, greater_than=0.0_rp)
+      end if
       call check_real(where, 'start_time', inlet%start_time, status, at_least=0.0_rp)
       call check_real(where, 'end_time', inlet%end_time, status, greater_than=inlet%start_time)
       if (.not. status%ok) return

@@ -405,6 +405,10 @@ contains
       dt = self%dt
       call self%timers%switch_to(phase_walls)
       call set_wall_activity(self%walls, self%time)
+      ! a hydrograph's feeder carries the speed of the fluid injected at the end of this step
+      do i = 1, size(self%inlets)
+         call self%inlets(i)%feed(self%walls, self%grid, self%time + dt)
+      end do
       call self%loads%begin_step(size(self%walls))
       if (self%volume%shifting) then
          call self%timers%switch_to(phase_volume_correction)
@@ -754,8 +758,8 @@ contains
    !> [m/s] on how fast the particles move: the largest signal speed c + |v| of the materials and open
    !> inlets, or with a fixed step a bound on the largest |v| (the sound speed is not needed then, and a
    !> blowing-up state may have no valid one). An inlet that is not closed yet counts as a particle of its
-   !> fluid at rho0 moving at v0: the step must resolve the fluid it is about to create (and an empty tank
-   !> must not take a huge step).
+   !> fluid at rho0 moving at v0 (a hydrograph: its largest speed until it closes): the step must resolve
+   !> the fluid it is about to create (and an empty tank must not take a huge step).
    subroutine time_step_of_speeds(self, speeds, dt, speed)
       type(solver_t), intent(in) :: self
       real(rp), intent(in) :: speeds(:)
@@ -768,7 +772,7 @@ contains
       if (self%run%fixed_dt > 0.0_rp) then
          dt = self%run%fixed_dt
          do i = 1, size(self%inlets)
-            if (self%time < self%inlets(i)%spec%end_time) speed = max(speed, self%inlets(i)%spec%velocity)
+            if (self%time < self%inlets(i)%spec%end_time) speed = max(speed, self%inlets(i)%peak_speed(self%time))
          end do
          return
       end if
@@ -777,7 +781,7 @@ contains
          associate (spec => self%inlets(i)%spec)
             if (self%time >= spec%end_time) cycle
             speed = max(speed, self%materials(spec%material_index)%model%wave_speed(self%inlets(i)%density) &
-                        + sqrt(sum((spec%velocity * spec%direction(1:self%grid%dim))**2)))
+                        + sqrt(sum((self%inlets(i)%peak_speed(self%time) * spec%direction(1:self%grid%dim))**2)))
          end associate
       end do
       if (speed > 0.0_rp) dt = self%run%cfl * self%grid%h / (sqrt(real(self%grid%dim, rp)) * speed)

@@ -7,7 +7,9 @@
 #
 # Each bad scene starts with the line
 #   ! expect: <text the error message must contain>
-# and sets a relative output_dir, so each run happens in a fresh temporary working directory.
+# and sets a relative output_dir, so each run happens in a fresh temporary working directory. More
+# `! expect:` lines right after the first add texts the message must also contain; `! expect: exit N`
+# asks for exit code N (mpiexec's: a rank that ended otherwise shows).
 set -u
 
 if [[ $# -lt 2 ]]; then
@@ -39,9 +41,9 @@ trap 'rm -rf "$work_root"' EXIT
 passed=0
 failed=0
 
-# check_case <name> <scene path> <expected substring> <output dir the scene asks for>
+# check_case <name> <scene path> <expected substrings, one per line> <output dir the scene asks for>
 check_case() {
-   local name=$1 scene=$2 expect=$3 output_dir=$4
+   local name=$1 scene=$2 expects=$3 output_dir=$4 expect exit_code=''
    local work="$work_root/$name"
    mkdir -p "$work"
    local rc=0
@@ -59,8 +61,15 @@ check_case() {
    if [[ $messages -ne 1 ]]; then
       problems+=("'flotsam: error:' printed $messages times instead of once")
    fi
-   if ! grep -qF -- "$expect" "$work_root/$name.err"; then
-      problems+=("stderr lacks: $expect")
+   while IFS= read -r expect; do
+      if [[ $expect =~ ^exit\ ([0-9]+)$ ]]; then
+         exit_code=${BASH_REMATCH[1]}
+      elif ! grep -qF -- "$expect" "$work_root/$name.err"; then
+         problems+=("stderr lacks: $expect")
+      fi
+   done <<<"$expects"
+   if [[ -n $exit_code && $rc -ne $exit_code ]]; then
+      problems+=("exit code $rc instead of $exit_code")
    fi
    if [[ -e "$work/$output_dir" ]]; then
       problems+=("output folder $output_dir was created")
@@ -88,7 +97,8 @@ output_dir_of() {
 
 for scene in "${scenes[@]}"; do
    name=$(basename "$scene" .nml)
-   expect=$(sed -n '1s/^! *expect: *//p' "$scene")
+   # the first line and the `! expect:` lines right after it
+   expect=$(awk '!/^! *expect:/ { exit } { sub(/^! *expect: */, ""); print }' "$scene")
    if [[ -z $expect ]]; then
       echo "FAIL $name: first line is not '! expect: <message text>'"
       failed=$((failed + 1))

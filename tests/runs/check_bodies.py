@@ -26,7 +26,7 @@ import numpy as np
 import pandas as pd
 
 from check_loads import agreement, read
-from flotsam_run import Checks, Flotsam, main_arguments
+from flotsam_run import Checks, Flotsam, checkpoint_at_step, main_arguments
 
 G = 9.81
 
@@ -165,11 +165,7 @@ def check_restart(checks, flotsam, csv_run):
     if not checks.check(result.returncode == 0, "restart: the points block stopped at step 250",
                         result.stderr[-2000:]):
         return
-    checkpoint = None
-    for path in glob.glob(flotsam.path("block_split", "checkpoints", "checkpoint_*.h5")):
-        with h5py.File(path) as f:
-            if int(f.attrs["step"]) == 200:
-                checkpoint = os.path.relpath(path, flotsam.workdir)
+    checkpoint, _ = checkpoint_at_step(flotsam, "block_split", 200)
     if not checks.check(checkpoint is not None, "restart: a checkpoint at step 200"):
         return
     with open(flotsam.path("block_continue.nml"), "w") as f:

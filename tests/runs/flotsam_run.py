@@ -156,6 +156,18 @@ def signal_ranks(process, signum):
     return pids
 
 
+def checkpoint_at_step(flotsam, output_dir, step):
+    """The checkpoint of `output_dir` (in flotsam's working directory) written at `step`: its path
+    relative to the working directory (for `--restart`) and its time; (None, None) if there is none."""
+    import glob
+    import h5py
+    for path in glob.glob(flotsam.path(output_dir, "checkpoints", "checkpoint_*.h5")):
+        with h5py.File(path) as f:
+            if int(f.attrs["step"]) == step:
+                return os.path.relpath(path, flotsam.workdir), float(f.attrs["time"])
+    return None, None
+
+
 def read_diagnostics(output_dir):
     """The rows of diagnostics.csv as dictionaries of strings (exact text, for bitwise comparisons)."""
     with open(os.path.join(output_dir, "diagnostics.csv")) as f:
@@ -223,5 +235,5 @@ def main_arguments():
     return sys.argv[1], sys.argv[2], os.path.abspath(sys.argv[3]), sys.argv[4:]
 
 
-__all__ = ["Checks", "Flotsam", "PrivateDisplay", "child_pids", "rank_pids", "wait_for_file", "wait_for_rows",
+__all__ = ["Checks", "Flotsam", "PrivateDisplay", "checkpoint_at_step", "child_pids", "rank_pids", "wait_for_file", "wait_for_rows",
            "signal_ranks", "read_diagnostics", "csv_data_lines", "signal", "main_arguments"]

@@ -5,7 +5,8 @@
 !>  - an inlet creates rho0 v0 H of mass per unit time exactly (one layer every Dp / v0), with ids that
 !>    do not depend on the number of ranks, and no particle ends behind a wall.
 module test_walls_and_inflow
-   use kinds, only: rp, i8
+   use kinds, only: rp, i8, name_len
+   use time_table, only: time_table_t
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_Allgather, MPI_Allgatherv, MPI_IN_PLACE, MPI_INTEGER, &
                       MPI_INTEGER8, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_MIN, MPI_Comm_size
    use assertions, only: assertTrue, assertEqual, assertRelativelyEqual
@@ -19,7 +20,7 @@ module test_walls_and_inflow
    private
 
    public :: test_wall_groups_equal_box_walls, test_quarter_turn_grid_is_the_same_tank, &
-             test_inflow_mass_flux_and_ids, test_no_particle_behind_a_wall
+             test_inflow_mass_flux_and_ids, test_no_particle_behind_a_wall, test_hydrograph_inflow
 
 contains
 
@@ -213,6 +214,54 @@ contains
       call assertTrue(step > 100, 'the open inlet limited the time step ('//int_text(step)//' steps to 0.15 s)')
       call solver%free()
    end subroutine check_inflow
+
+   !> A hydrograph through the 0.5 m opening: v = 1 -> 3 m/s and H = 0.2 -> 0.5 m linear over the 0.1 s it
+   !> is open (height_from_file). Then int v H dt = 0.2 t + 3.5 t^2 + 20 t^3 and L(0.1) = 0.2 m = 6 Dp.
+   !> The mass injected is that integral up to less than one layer rho Dp H_max after every step, exactly
+   !> it at the end (6 whole layers); ids are unique, within the 6 layers' stride, on any number of ranks.
+   subroutine test_hydrograph_inflow(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(scene_t) :: scene
+      type(solver_t) :: solver
+      type(status_t) :: status
+      type(diagnostics_t) :: diag
+      real(rp), parameter :: rho = 1000.0_rp, spacing = 0.1_rp / 3
+      real(rp) :: t, expected
+      integer(i8), allocatable :: ids(:)
+      integer :: step, k
+
+      scene = inflow_scene()
+      scene%inlets(1)%velocity = 0.0_rp
+      scene%inlets(1)%velocity_file = 'hydrograph.csv'
+      scene%inlets(1)%height_from_file = .true.
+      allocate (scene%inlet_tables(1))
+      scene%inlet_tables(1) = time_table_t(path='hydrograph.csv', checksum='', &
+                                           columns=[character(len=name_len) :: 'velocity', 'height'], &
+                                           time=[0.0_rp, 0.1_rp], values=reshape([1.0_rp, 0.2_rp, 3.0_rp, 0.5_rp], [2, 2]), &
+                                           line=[2, 3])
+      call solver%init(scene, comm, status)
+      call assertTrue(status%ok, 'init: '//trim(status%message))
+      do step = 1, 2000
+         call solver%advance()
+         diag = solver%diagnostics()
+         t = min(solver%time, 0.1_rp)
+         expected = rho * (0.2_rp * t + 3.5_rp * t**2 + 20.0_rp * t**3)
+         call assertTrue(diag%total_mass <= expected * (1.0_rp + 1.0e-12_rp) .and. &
+                         diag%total_mass >= expected - rho * spacing * 0.5_rp, &
+                         'mass '//real_text(diag%total_mass)//' = rho int v H dt = '//real_text(expected)// &
+                         ' within one layer at t = '//real_text(solver%time))
+         if (solver%time > 0.15_rp) exit
+      end do
+      call assertRelativelyEqual(rho * 0.075_rp, diag%total_mass, 1.0e-9_rp, 'total = rho int v H dt over the open time')
+      ids = gathered_ids(solver, comm)
+      call assertTrue(all(ids(2:) > ids(:size(ids) - 1)), 'ids unique')
+      call assertTrue(ids(1) >= 0 .and. ids(size(ids)) < 6 * 15, 'ids within the 6 layers of 15 across')
+      ! layers across: about H_k / Dp, H_k between 0.2 and 0.5 m
+      k = size(ids)
+      call assertTrue(k >= 6 * 6 .and. k <= 6 * 15, int_text(k)//' particles in 6 layers of 6 to 15')
+      call assertTrue(step > 100, 'the table''s peak speed limited the time step ('//int_text(step)//' steps)')
+      call solver%free()
+   end subroutine test_hydrograph_inflow
 
    !> Every rank's particle ids, sorted.
    function gathered_ids(solver, comm) result(ids)
