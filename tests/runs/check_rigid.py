@@ -11,9 +11,11 @@
   3. a box spinning and drifting in a vacuum (2-D): angle = omega t and velocity unchanged to round-off;
      a box of three different edges tumbling in 3-D: its angular momentum sum m (x - c) x v from the
      fields files stays what it was to round-off (relative 1e-12), its kinetic energy within 1 %;
-  4. restart: the dropped box stopped mid-fall and continued from its checkpoint gives bodies.csv and
+  4. a rigid block on a turned &structure incline with Coulomb friction: acceleration g (sin - mu cos)
+     within 1e-6 (mu = 0.3, and slip), at rest for mu = 0.6 > tan 30 degrees;
+  5. restart: the dropped box stopped mid-fall and continued from its checkpoint gives bodies.csv and
      loads.csv byte for byte;
-  5. bad input: a rigid material given elastic constants or a stabilization, a 2-D angular velocity
+  6. bad input: a rigid material given elastic constants or a stabilization, a 2-D angular velocity
      about x, a rigid material in &contact: one-line errors naming the file, the group and the
      variable, exit 2, no output folder.
 With --long (label validation) instead: Archimedes, a rigid flat block released 2.5 cm above its
@@ -146,6 +148,31 @@ def check_spin(checks, flotsam, scenes):
                                  "explicit: energy is not conserved exactly)")
 
 
+def check_incline(checks, flotsam, scenes):
+    scene = os.path.join(scenes, "rigid", "incline.nml")
+    theta = np.radians(30.0)
+    for mu, condition in ((0.3, "friction"), (0.0, "slip"), (0.6, "friction")):
+        name = f"incline_{condition}_{mu}".replace(".", "_")
+        flotsam.remove(name)
+        path = flotsam.scene(scene, name + ".nml", name)
+        result = flotsam.run(path, 2, "--set", f"&structure condition = '{condition}', friction = {mu} /")
+        if not checks.check(result.returncode == 0, f"{name}: run on 2 ranks", result.stderr[-2000:]):
+            continue
+        bodies = read(flotsam.path(name), "bodies")
+        t, v = bodies["time"].to_numpy(), bodies["block_vx"].to_numpy()
+        window = t > 0.1
+        acceleration = np.polyfit(t[window], v[window], 1)[0]
+        lifted = np.abs(bodies["block_vy"].to_numpy()).max()
+        if mu < np.tan(theta):
+            exact = G * (np.sin(theta) - mu * np.cos(theta))
+            checks.check(abs(acceleration / exact - 1) <= 1e-6 and lifted <= 1e-9,
+                         f"incline, {condition} mu = {mu}: acceleration {acceleration:.7g} m/s^2 against g (sin - mu "
+                         f"cos) = {exact:.7g} ({acceleration / exact - 1:+.1e}), normal speed <= {lifted:.1e} m/s")
+        else:
+            checks.check(np.abs(v).max() <= 1e-9, f"incline, mu = {mu} >= tan theta: it stays (speed <= "
+                                                  f"{np.abs(v).max():.1e} m/s)")
+
+
 def check_restart(checks, flotsam, scenes, whole):
     template = os.path.join(scenes, "rigid", "drop_2d.nml")
     name = "drop_2d_split"
@@ -236,6 +263,7 @@ def main():
     whole = check_drop_2d(checks, flotsam, scenes)
     check_drop_3d(checks, flotsam, scenes)
     check_spin(checks, flotsam, scenes)
+    check_incline(checks, flotsam, scenes)
     if whole:
         check_restart(checks, flotsam, scenes, whole)
     check_errors(checks, flotsam, scenes)
