@@ -1487,13 +1487,6 @@ contains
                                 quoted_list(declared)//"), got '"//trim(contact%between(k))//"'")
                return
             end if
-            if (materials(m)%model == model_rigid) then
-               call status%fail(where//": variable between names the rigid material '"//trim(contact%between(k))// &
-                                "': contact of rigid bodies through &contact is not implemented yet (a rigid body "// &
-                                'meets walls and structures as a body, and the fluid and other solids through the '// &
-                                'common velocity field: docs/theory.md section 3.6)')
-               return
-            end if
             if (materials(m)%model == model_newtonian_fluid) then
                call status%fail(where//": variable between names the fluid '"//trim(contact%between(k))// &
                                 "': contact of a fluid is not implemented (fluids share the common velocity "// &

@@ -578,12 +578,17 @@ contains
 
    !> The rigid bodies' step (rigid_bodies): each moves with the rigid projection of the nodal increments of
    !> its nodes and the walls' contact; the impulses the walls give them count in the loads on rank 0.
-   !> Without &contact (scene_validation refuses a rigid material in one). Collective.
+   !> With &contact on the fields' velocities (rigid_bodies). Collective.
    subroutine solve_rigid_bodies(self, dt)
       type(solver_t), intent(inout) :: self
       real(rp), intent(in) :: dt
-      call self%rigid%solve(self%domain, self%grid, self%particles, self%walls, dt, self%domain%rank == 0, &
-                            self%loads%step_impulse)
+      if (self%contact%active) then
+         call self%rigid%solve(self%domain, self%grid, self%particles, self%walls, dt, self%domain%rank == 0, &
+                               self%loads%step_impulse, self%contact, self%loads%field_impulse)
+      else
+         call self%rigid%solve(self%domain, self%grid, self%particles, self%walls, dt, self%domain%rank == 0, &
+                               self%loads%step_impulse)
+      end if
    end subroutine solve_rigid_bodies
 
    !> MUSL: update the particle velocities, then nodal velocities from their momentum, with walls.
@@ -594,6 +599,8 @@ contains
       if (self%contact%active) then
          call update_velocity_and_remap(self%grid, self%particles, self%run%flip_fraction, self%contact%remapped, &
                                         self%contact%particle_field, self%contact%velocity, self%contact%increment)
+         if (self%rigid%active) call self%rigid%remap_correction(self%grid, self%particles, self%contact%remapped, &
+                                                                 self%contact%particle_field)
          call self%timers%switch_to(phase_halo)
          call sum_shared_nodes(self%domain, self%grid, self%contact%remapped)
          call self%timers%switch_to(phase_grid_to_particles)

@@ -42,6 +42,7 @@ module rigid_bodies
    use grid_transfer, only: spread_to_grid, mass_to_grid
    use domain_decomposition, only: domain_t
    use node_halo, only: sum_shared_nodes
+   use body_contact, only: contact_t
    use small_matrices, only: cross, identity, rotation_of, inverse_3x3
    implicit none
    private
@@ -206,8 +207,13 @@ contains
    !> the walls' contact on the body's particles adds its impulses to S's motion, the nodes of S take the
    !> rigid increments dv_i = dV + dw x (x_i - c_S) (so the fluid there moves with the body), and the body
    !> its share: V += dV + dw x (c - c_S), L += I dw. On the rank with `records_loads`, impulse(:, w) gains
-   !> the impulses wall w gave the bodies. Collective.
-   subroutine rigid_solve(self, domain, grid, particles, walls, dt, records_loads, impulse)
+   !> the impulses wall w gave the bodies. With `contact` (its fields active) the nodal velocities are the
+   !> fields' (body_contact): a body of a material in some &contact is its field f; at a node where the
+   !> fields separated this step its cluster has that field's mass and only that field takes the rigid
+   !> increment, elsewhere all fields move together (the total mass, every field's rows); a structure of
+   !> its &contact acts on it with the pair's mu, and field_impulse(:, w, f) gains its share of the load.
+   !> Collective.
+   subroutine rigid_solve(self, domain, grid, particles, walls, dt, records_loads, impulse, contact, field_impulse)
       class(rigid_set_t), intent(inout) :: self
       type(domain_t), intent(in) :: domain
       type(grid_t), intent(inout) :: grid
@@ -216,14 +222,31 @@ contains
       real(rp), intent(in) :: dt
       logical, intent(in) :: records_loads
       real(rp), intent(inout) :: impulse(:, :)
+      type(contact_t), intent(inout), optional :: contact
+      real(rp), intent(inout), optional :: field_impulse(:, :, :)
       integer, parameter :: width = 1 + 3 + 3 + 3 + 9
       real(rp) :: sums(width, size(self%bodies)), x(3), dv(3), r(3)
       real(rp), allocatable :: share(:, :), records(:, :), all_records(:, :), applied(:, :), motion(:, :)
       integer, allocatable :: owner(:), order(:)
-      integer :: rows(block_size), m, first, last, b0, e, n, q, p, b, d, found, total, i, j, k, g(3)
+      integer :: rows(block_size), m, first, last, b0, e, n, q, p, b, d, found, total, i, j, k, g(3), f
+      integer :: field(size(self%bodies))
       real(rp) :: mass
+      real(rp), allocatable :: field_friction(:, :)
+      logical :: fields
 
       d = self%dim
+      ! the velocity field of each body: 0 (the common one), or its own with &contact
+      fields = .false.
+      if (present(contact)) fields = contact%active
+      field = 0
+      if (fields) then
+         do b = 1, size(self%bodies)
+            do f = 1, contact%fields
+               if (contact%first_id(f) == self%bodies(b)%first_id) field(b) = f
+            end do
+         end do
+         field_friction = contact%wall_friction(size(walls))
+      end if
       ! the bodies' masses on the nodes, and the contact points of their particles
       allocate (share(size(self%bodies), grid%node_count), records(record_width, 64))
       share = 0.0_rp
@@ -261,11 +284,17 @@ contains
          if (b == 0) cycle
          g(1:d) = grid%node_indices(i)
          if (.not. grid%owns_node(g(1:d))) cycle
-         mass = grid%accumulated(row_mass, i)
          x = 0.0_rp
          dv = 0.0_rp
          x(1:d) = grid%origin(1:d) + g(1:d) * grid%h - self%bodies(b)%centre(1:d)
-         dv(1:d) = grid%velocity_increment(:, i)
+         mass = grid%accumulated(row_mass, i)
+         if (fields) then
+            f = field(b)
+            if (f > 0 .and. contact%separate(i)) mass = grid%accumulated(contact%field_row + (f - 1) * contact%stride, i)
+            dv(1:d) = contact%increment(f * d + 1:f * d + d, i)
+         else
+            dv(1:d) = grid%velocity_increment(:, i)
+         end if
          associate (s => sums(:, b))
             s(1) = s(1) + mass
             s(2:4) = s(2:4) + mass * x
@@ -301,8 +330,16 @@ contains
          x(1:d) = grid%origin(1:d) + grid%node_indices(i) * grid%h
          x = x - motion(7:9, b)
          dv = motion(1:3, b) + cross(motion(4:6, b), x)
-         grid%velocity(:, i) = grid%velocity(:, i) + (dv(1:d) - grid%velocity_increment(:, i))
-         grid%velocity_increment(:, i) = dv(1:d)
+         if (.not. fields) then
+            grid%velocity(:, i) = grid%velocity(:, i) + (dv(1:d) - grid%velocity_increment(:, i))
+            grid%velocity_increment(:, i) = dv(1:d)
+         else if (field(b) > 0 .and. contact%separate(i)) then
+            call take_increment(field(b))
+         else
+            do f = 0, contact%fields
+               call take_increment(f)
+            end do
+         end if
       end do
       if (records_loads) call record_loads()
 
@@ -330,6 +367,9 @@ contains
             case default
                mu = 0.0_rp
             end select
+            if (fields .and. field(b) > 0) then
+               if (field_friction(w, field(b)) >= 0.0_rp) mu = field_friction(w, field(b))
+            end if
             if (found == size(records, 2)) then
                allocate (grown(record_width, 2 * found))
                grown(:, 1:found) = records(:, 1:found)
@@ -354,8 +394,21 @@ contains
             arm(1:d) = arm(1:d) - walls(w)%moment_point(1:d)
             impulse(1:d, w) = impulse(1:d, w) + j(1:d)
             impulse(4:6, w) = impulse(4:6, w) + cross(arm, j)
+            if (present(field_impulse) .and. field(b) > 0) then
+               field_impulse(1:d, w, field(b)) = field_impulse(1:d, w, field(b)) + j(1:d)
+               field_impulse(4:6, w, field(b)) = field_impulse(4:6, w, field(b)) + cross(arm, j)
+            end if
          end do
       end subroutine record_loads
+
+      !> Field f's rows of the contact velocities at node i take the increment dv.
+      subroutine take_increment(f)
+         integer, intent(in) :: f
+         associate (v => contact%velocity(f * d + 1:f * d + d, i), inc => contact%increment(f * d + 1:f * d + d, i))
+            v = v + (dv(1:d) - inc)
+            inc = dv(1:d)
+         end associate
+      end subroutine take_increment
    end subroutine rigid_solve
 
    !> One body's cluster (its sums over S, about its centre c): the rigid projection of the increments, the
@@ -536,13 +589,15 @@ contains
    end subroutine resolve_contacts
 
    !> MUSL, after update_velocity_and_remap: the rigid particles take their body's velocity at x^n,
-   !> V^{n+1} + w x (x_p - c^n) (APIC: C_p = [w]), and `momentum` (the re-map, rows 1:dim; with `field`
-   !> also the particle's field's rows) the change of their momentum. Before finish.
-   subroutine rigid_remap_correction(self, grid, particles, momentum)
+   !> V^{n+1} + w x (x_p - c^n) (APIC: C_p = [w]), and `momentum` (the re-map, rows 1:dim; with `field`,
+   !> the particles' contact fields, also rows field(p) dim + 1..) the change of their momentum. Before
+   !> finish.
+   subroutine rigid_remap_correction(self, grid, particles, momentum, field)
       class(rigid_set_t), intent(in) :: self
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
       real(rp), intent(inout) :: momentum(:, :)
+      integer, intent(in), optional :: field(:)
       real(rp), allocatable :: change(:, :)
       real(rp) :: r(3), v(3), c(self%dim * self%dim)
       integer :: offsets(block_size), m, first, last, b0, e, n, q, p, b, d, rows
@@ -558,6 +613,7 @@ contains
             e = min(last, b0 + block_size - 1)
             n = e - b0 + 1
             offsets(1:n) = 0
+            if (present(field)) offsets(1:n) = field(b0:e) * d
             do q = 1, n
                p = b0 + q - 1
                change(:, q) = 0.0_rp

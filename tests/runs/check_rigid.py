@@ -13,10 +13,12 @@
      fields files stays what it was to round-off (relative 1e-12), its kinetic energy within 1 %;
   4. a rigid block on a turned &structure incline with Coulomb friction: acceleration g (sin - mu cos)
      within 1e-6 (mu = 0.3, and slip), at rest for mu = 0.6 > tan 30 degrees;
-  5. restart: the dropped box stopped mid-fall and continued from its checkpoint gives bodies.csv and
+  5. &contact: a rigid box and an elastic block meeting off-centre in a vacuum keep the total momentum
+     (1e-12 of either's), do not overlap, stop each other and turn the rigid box;
+  6. restart: the dropped box stopped mid-fall and continued from its checkpoint gives bodies.csv and
      loads.csv byte for byte;
-  6. bad input: a rigid material given elastic constants or a stabilization, a 2-D angular velocity
-     about x, a rigid material in &contact: one-line errors naming the file, the group and the
+  7. bad input: a rigid material given elastic constants or a stabilization, a 2-D angular velocity
+     about x: one-line errors naming the file, the group and the
      variable, exit 2, no output folder.
 With --long (label validation) instead: Archimedes, a rigid flat block released 2.5 cm above its
 equilibrium in a FOAL1 tank (scenes/rigid/floating_rigid.nml) floats at the draft (rho_s / rho_f) H_b
@@ -173,6 +175,25 @@ def check_incline(checks, flotsam, scenes):
                                                   f"{np.abs(v).max():.1e} m/s)")
 
 
+def check_collision(checks, flotsam, scenes):
+    directory = run(checks, flotsam, os.path.join(scenes, "rigid", "collide.nml"), "collide", 2)
+    if directory is None:
+        return
+    bodies = read(directory, "bodies")
+    mass = 500.0 * 0.3 * 0.2
+    momentum = mass * (bodies["left_vx"].to_numpy() + bodies["right_vx"].to_numpy())
+    momentum_y = mass * (bodies["left_vy"].to_numpy() + bodies["right_vy"].to_numpy())
+    worst = max(np.abs(momentum).max(), np.abs(momentum_y).max()) / (mass * 0.5)
+    gap = (bodies["right_x"].to_numpy() - 0.15) - (bodies["left_x"].to_numpy() + 0.15)
+    after = bodies["time"].to_numpy() > 0.45
+    checks.check(worst <= 1e-12, f"collide: total momentum kept to {worst:.1e} of either body's")
+    checks.check(gap.min() >= 0.0, f"collide: no overlap (smallest gap {gap.min():.4f} m)")
+    checks.check(np.abs(bodies["left_vx"].to_numpy()[after]).max() < 0.05 and
+                 np.abs(bodies["left_angle"].to_numpy()[-1]) > 0.01,
+                 f"collide: the block stops the rigid box (|vx| <= {np.abs(bodies['left_vx'].to_numpy()[after]).max():.3f} "
+                 f"m/s after 0.45 s, from 0.5) and turns it ({bodies['left_angle'].to_numpy()[-1]:.3f} rad)")
+
+
 def check_restart(checks, flotsam, scenes, whole):
     template = os.path.join(scenes, "rigid", "drop_2d.nml")
     name = "drop_2d_split"
@@ -215,8 +236,6 @@ def check_errors(checks, flotsam, scenes):
          "group &material (1st, name 'crate'): variable stabilization must be 'none' for model 'rigid'"),
         ("spin_about_x", text.replace(body, body + " angular_velocity = 1.0, 0.0, 0.0,"),
          "variable angular_velocity turns a 2-D body about z only"),
-        ("rigid_contact", text + "&contact between = 'crate', 'crate' /\n",
-         "group &contact (1st, between 'crate', 'crate'): variable between names the rigid material 'crate'"),
     ]
     for name, scene, expected in cases:
         flotsam.remove(name)
@@ -264,6 +283,7 @@ def main():
     check_drop_3d(checks, flotsam, scenes)
     check_spin(checks, flotsam, scenes)
     check_incline(checks, flotsam, scenes)
+    check_collision(checks, flotsam, scenes)
     if whole:
         check_restart(checks, flotsam, scenes, whole)
     check_errors(checks, flotsam, scenes)
