@@ -140,23 +140,38 @@ contains
       type(MPI_Comm), intent(in) :: comm
       integer, parameter :: width = 1 + 3 + 3 + 3 + 9 + 3
       real(rp) :: sums(width, size(self%bodies)), x(3), xr(3), v(3), anchor(3), mean_x(3), rr(3, 3), spread(3, 3)
-      integer :: b, p, d, i, j
+      real(rp), allocatable :: mine(:, :), all(:, :)
+      integer, allocatable :: order(:)
+      integer :: b, p, d, i, j, n, c
       integer(i8) :: k
       d = self%dim
-      sums = 0.0_rp
+      ! every rank's rigid particles (id, body, m, x, v), summed in the order of their ids on every rank: the
+      ! same sums, bit for bit, on any number of ranks
+      allocate (mine(12, particles%count))
+      n = 0
       do p = 1, particles%count
          if (.not. self%rigid_material(particles%material(p))) cycle
          b = body_of(self, particles%material(p), particles%id(p))
          if (b == 0) cycle
-         associate (body => self%bodies(b), s => sums(:, b), m => particles%mass(p))
+         n = n + 1
+         mine(:, n) = 0.0_rp
+         mine(1:3, n) = [real(particles%id(p), rp), real(b, rp), particles%mass(p)]
+         mine(4:3 + d, n) = particles%x(:, p)
+         mine(7:6 + d, n) = particles%v(:, p)
+      end do
+      call gather_columns(mine(:, 1:n), comm, comm_other, all)
+      order = key_order(int(all(1, :), i8))
+      sums = 0.0_rp
+      do c = 1, size(order)
+         b = nint(all(2, order(c)))
+         associate (body => self%bodies(b), s => sums(:, b), m => all(3, order(c)))
             anchor = tracked%bodies(body%tracked)%centre
-            k = particles%id(p) - body%first_id
+            k = int(all(1, order(c)), i8) - body%first_id
             x = 0.0_rp
             xr = 0.0_rp
-            v = 0.0_rp
-            x(1:d) = particles%x(:, p) - anchor(1:d)
+            x(1:d) = all(4:3 + d, order(c)) - anchor(1:d)
             xr(1:d) = tracked%reference(body%tracked, k, grid%frame) - anchor(1:d)
-            v(1:d) = particles%v(:, p)
+            v = all(7:9, order(c))
             s(1) = s(1) + m
             s(2:4) = s(2:4) + m * xr
             s(5:7) = s(5:7) + m * x
@@ -169,8 +184,6 @@ contains
             s(20:22) = s(20:22) + m * cross(x, v)
          end associate
       end do
-      call MPI_Allreduce(MPI_IN_PLACE, sums, size(sums), MPI_DOUBLE_PRECISION, MPI_SUM, comm)
-      call count_collective(comm_other, size(sums), real_bytes)
       do b = 1, size(self%bodies)
          associate (body => self%bodies(b), s => sums(:, b))
             anchor = tracked%bodies(body%tracked)%centre
@@ -226,7 +239,8 @@ contains
       real(rp), intent(inout), optional :: field_impulse(:, :, :)
       integer, parameter :: width = 1 + 3 + 3 + 3 + 9
       real(rp) :: sums(width, size(self%bodies)), x(3), dv(3), r(3)
-      real(rp), allocatable :: share(:, :), records(:, :), all_records(:, :), applied(:, :), motion(:, :)
+      real(rp), allocatable :: share(:, :), records(:, :), all_records(:, :), applied(:, :), motion(:, :), nodes(:, :)
+      real(rp), allocatable :: all_nodes(:, :)
       integer, allocatable :: owner(:), order(:)
       integer :: rows(block_size), m, first, last, b0, e, n, q, p, b, d, found, total, i, j, k, g(3), f
       integer :: field(size(self%bodies))
@@ -276,18 +290,18 @@ contains
          if (any(share(:, i) > 0.0_rp)) owner(i) = maxloc(share(:, i), 1)
       end do
 
-      ! each cluster's mass, centre, increments and second moment (about the body's centre), owned nodes
-      sums = 0.0_rp
+      ! each cluster's owned nodes (global index, body, mass, dv), gathered and summed in the order of the
+      ! global index on every rank: the same sums, bit for bit, on any number of ranks
+      allocate (nodes(6, count(owner > 0)))
+      n = 0
       g = 0
       do i = 1, grid%node_count
          b = owner(i)
          if (b == 0) cycle
          g(1:d) = grid%node_indices(i)
          if (.not. grid%owns_node(g(1:d))) cycle
-         x = 0.0_rp
-         dv = 0.0_rp
-         x(1:d) = grid%origin(1:d) + g(1:d) * grid%h - self%bodies(b)%centre(1:d)
          mass = grid%accumulated(row_mass, i)
+         dv = 0.0_rp
          if (fields) then
             f = field(b)
             if (f > 0 .and. contact%separate(i)) mass = grid%accumulated(contact%field_row + (f - 1) * contact%stride, i)
@@ -295,21 +309,34 @@ contains
          else
             dv(1:d) = grid%velocity_increment(:, i)
          end if
+         n = n + 1
+         nodes(:, n) = [real(node_key(g), rp), real(b, rp), mass, dv]
+      end do
+      call gather_columns(nodes(:, 1:n), domain%comm, comm_rigid, all_nodes)
+      order = key_order(int(all_nodes(1, :), i8))
+      sums = 0.0_rp
+      do k = 1, size(order)
+         associate (node => all_nodes(:, order(k)))
+            b = nint(node(2))
+            mass = node(3)
+            dv = node(4:6)
+            g = key_node(int(node(1), i8))
+            x = 0.0_rp
+            x(1:d) = grid%origin(1:d) + g(1:d) * grid%h - self%bodies(b)%centre(1:d)
+         end associate
          associate (s => sums(:, b))
             s(1) = s(1) + mass
             s(2:4) = s(2:4) + mass * x
             s(5:7) = s(5:7) + mass * dv
             s(8:10) = s(8:10) + mass * cross(x, dv)
-            do k = 1, 3
-               do j = 1, 3
-                  s(10 + j + 3 * (k - 1)) = s(10 + j + 3 * (k - 1)) + mass * x(j) * x(k)
+            do j = 1, 3
+               do p = 1, 3
+                  s(10 + p + 3 * (j - 1)) = s(10 + p + 3 * (j - 1)) + mass * x(p) * x(j)
                end do
             end do
          end associate
       end do
-      call MPI_Allreduce(MPI_IN_PLACE, sums, size(sums), MPI_DOUBLE_PRECISION, MPI_SUM, domain%comm)
-      call count_collective(comm_rigid, size(sums), real_bytes)
-      call gather_records(records(:, 1:found), domain%comm, all_records)
+      call gather_columns(records(:, 1:found), domain%comm, comm_rigid, all_records)
       total = size(all_records, 2)
       self%contact_points = total
       order = record_order(all_records)
@@ -401,6 +428,22 @@ contains
          end do
       end subroutine record_loads
 
+      !> The global node g as one integer (x fastest) and back.
+      integer(i8) function node_key(g)
+         integer, intent(in) :: g(3)
+         node_key = int(g(1), i8) + int(grid%global_cells(1) + 1, i8) * (int(g(2), i8) + &
+                    int(grid%global_cells(2) + 1, i8) * int(g(3), i8))
+      end function node_key
+
+      function key_node(key) result(g)
+         integer(i8), intent(in) :: key
+         integer :: g(3)
+         integer(i8) :: nx, ny
+         nx = grid%global_cells(1) + 1
+         ny = grid%global_cells(2) + 1
+         g = int([mod(key, nx), mod(key / nx, ny), key / (nx * ny)])
+      end function key_node
+
       !> Field f's rows of the contact velocities at node i take the increment dv.
       subroutine take_increment(f)
          integer, intent(in) :: f
@@ -459,10 +502,11 @@ contains
       body%next_spin = matmul(inverse_inertia(body, body%next_rotation, self%dim), body%angular_momentum)
    end subroutine project_cluster
 
-   !> Every rank's contact point records (record_width, n) on every rank, in rank order. Collective.
-   subroutine gather_records(mine, comm, all)
+   !> Every rank's columns `mine` (rows, n) on every rank, in rank order, counted under `category`. Collective.
+   subroutine gather_columns(mine, comm, category, all)
       real(rp), intent(in) :: mine(:, :)
       type(MPI_Comm), intent(in) :: comm
+      integer, intent(in) :: category
       real(rp), allocatable, intent(out) :: all(:, :)
       integer, allocatable :: counts(:), displacements(:)
       integer :: nranks, r, n
@@ -470,42 +514,63 @@ contains
       allocate (counts(nranks), displacements(nranks))
       n = size(mine)
       call MPI_Allgather(n, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, comm)
-      call count_collective(comm_rigid, 1, int_bytes)
+      call count_collective(category, 1, int_bytes)
       displacements(1) = 0
       do r = 2, nranks
          displacements(r) = displacements(r - 1) + counts(r - 1)
       end do
-      allocate (all(record_width, sum(counts) / record_width))
+      allocate (all(size(mine, 1), sum(counts) / size(mine, 1)))
       if (sum(counts) == 0) return
       call MPI_Allgatherv(mine, n, MPI_DOUBLE_PRECISION, all, counts, displacements, MPI_DOUBLE_PRECISION, comm)
-      call count_collective(comm_rigid, sum(counts), real_bytes)
-   end subroutine gather_records
+      call count_collective(category, sum(counts), real_bytes)
+   end subroutine gather_columns
 
-   !> The records in the order of (particle id, wall): the same on any number of ranks.
+   !> The contact records in the order of (particle id, wall): the same on any number of ranks.
    function record_order(records) result(order)
       real(rp), intent(in) :: records(:, :)
       integer, allocatable :: order(:)
-      integer(i8), allocatable :: keys(:)
-      integer :: n, c, i, key_walls
-      integer(i8) :: key
-      n = size(records, 2)
-      allocate (order(n), keys(n))
+      integer :: key_walls
       key_walls = 1
-      if (n > 0) key_walls = nint(maxval(records(2, :))) + 1
-      ! insertion sort: a few hundred points, nearly in order already (ranks hold contiguous id ranges)
-      do c = 1, n
-         key = int(records(1, c), i8) * key_walls + nint(records(2, c))
-         i = c - 1
-         do while (i >= 1)
-            if (keys(i) <= key) exit
-            keys(i + 1) = keys(i)
-            order(i + 1) = order(i)
-            i = i - 1
-         end do
-         keys(i + 1) = key
-         order(i + 1) = c
-      end do
+      if (size(records, 2) > 0) key_walls = nint(maxval(records(2, :))) + 1
+      order = key_order(int(records(1, :), i8) * key_walls + nint(records(2, :), i8))
    end function record_order
+
+   !> The permutation that sorts `keys` ascending (stable bottom-up merge sort: the gathered columns are
+   !> runs in order per rank, interleaved across ranks).
+   function key_order(keys) result(order)
+      integer(i8), intent(in) :: keys(:)
+      integer, allocatable :: order(:), merged(:)
+      integer :: n, width, lo, mid, hi, i, j, k
+      n = size(keys)
+      order = [(i, i = 1, n)]
+      allocate (merged(n))
+      width = 1
+      do while (width < n)
+         do lo = 1, n, 2 * width
+            mid = min(lo + width - 1, n)
+            hi = min(lo + 2 * width - 1, n)
+            i = lo
+            j = mid + 1
+            do k = lo, hi
+               if (j > hi) then
+                  merged(k) = order(i)
+                  i = i + 1
+               else if (i > mid) then
+                  merged(k) = order(j)
+                  j = j + 1
+               else if (keys(order(j)) < keys(order(i))) then
+                  merged(k) = order(j)
+                  j = j + 1
+               else
+                  merged(k) = order(i)
+                  i = i + 1
+               end if
+            end do
+         end do
+         order = merged
+         width = 2 * width
+      end do
+   end function key_order
 
    !> Projected Gauss-Seidel over the contact points of body b (in `order`): accumulated normal impulses
    !> lambda_n >= 0 that keep u_n >= -g / dt, and tangential impulses within mu lambda_n (mu < 0: no bound).
