@@ -9,12 +9,18 @@ usage: pvbatch scripts/render_step.py <output folder> [--step N | --time T] [-o 
 --time T    the output nearest to simulated time T [s]
 --array     any particle array of particles.xmf (default mean_stress [Pa])
 --range     fixed colour range (default: the range of the step)
+--structures  3-D: draw the scene's &structure boxes, cylinders and spheres in grey (from the run's
+            resolved scene.nml)
+--camera DX DY DZ  3-D: the camera's direction from the scene's centre (default 1.0 -2.5 1.2: from
+            the front, a little above)
 
 Needs Debian's python3-paraview (pvbatch). The output folder must hold particles.xmf (&run
 particle_output = .true.)."""
 
 import argparse
+import math
 import os
+import re
 import sys
 
 from paraview import simple
@@ -30,7 +36,69 @@ def parse():
     parser.add_argument("--array", default="mean_stress", help="particle array to colour by")
     parser.add_argument("--range", type=float, nargs=2, metavar=("MIN", "MAX"), help="colour range")
     parser.add_argument("--size", type=int, nargs=2, default=[1200, 700], metavar=("W", "H"), help="pixels")
+    parser.add_argument("--structures", action="store_true", help="3-D: draw the scene's structures")
+    parser.add_argument("--camera", type=float, nargs=3, default=[1.0, -2.5, 1.2], metavar=("DX", "DY", "DZ"),
+                        help="3-D: camera direction from the centre")
     return parser.parse_args()
+
+
+def structures(run):
+    """The &structure groups of the run's resolved scene.nml (one variable per line) as dicts."""
+    text = open(os.path.join(run, "scene.nml")).read()
+    found = []
+    for group in re.findall(r"^&structure\n(.*?)^/", text, re.MULTILINE | re.DOTALL):
+        values = {}
+        for name, value in re.findall(r"^\s*(\w+) = (.*)$", group, re.MULTILINE):
+            value = value.strip()
+            values[name] = value.strip("'") if value.startswith("'") else [float(v) for v in value.split(",") if v.strip()]
+        found.append(values)
+    return found
+
+
+def rotation_onto(vector, target):
+    """(angle in degrees, axis) of the rotation taking vector onto target (both 3-vectors)."""
+    a = [c / math.sqrt(sum(x * x for x in vector)) for c in vector]
+    b = [c / math.sqrt(sum(x * x for x in target)) for c in target]
+    axis = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    sine = math.sqrt(sum(c * c for c in axis))
+    cosine = sum(x * y for x, y in zip(a, b))
+    if sine < 1e-12:
+        return (0.0 if cosine > 0 else 180.0), ([1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
+    return math.degrees(math.atan2(sine, cosine)), axis
+
+
+def show_structures(run, view):
+    """Grey, opaque sources for the 3-D structures (box, cylinder, sphere) of the run's scene."""
+    for structure in structures(run):
+        shape = structure.get("shape", "box")
+        centre = structure["centre"]
+        if shape == "box":
+            source = simple.Box(Center=[0.0, 0.0, 0.0], XLength=structure["size"][0],
+                                YLength=structure["size"][1], ZLength=structure["size"][2])
+            angle, axis = structure["rotation"][0], structure["rotation_axis"]
+        elif shape == "cylinder":              # VTK's cylinder lies along y
+            source = simple.Cylinder(Center=[0.0, 0.0, 0.0], Radius=structure["radius"][0],
+                                     Height=structure["length"][0], Resolution=48)
+            angle, axis = rotation_onto([0.0, 1.0, 0.0], structure["axis"])
+        elif shape == "sphere":
+            source = simple.Sphere(Center=[0.0, 0.0, 0.0], Radius=structure["radius"][0],
+                                   ThetaResolution=48, PhiResolution=24)
+            angle, axis = 0.0, [0.0, 0.0, 1.0]
+        else:
+            print(f"render_step: structure '{structure.get('name')}' ({shape}) not drawn", file=sys.stderr)
+            continue
+        turned = simple.Transform(Input=source)
+        turned.Transform = "Transform"
+        turned.Transform.Translate = centre
+        if angle:
+            # VTK turns about x, y, z in turn; one turn about an arbitrary axis as a rotation vector is
+            # not offered, so put the axis turn into a vtkTransform
+            from vtkmodules.vtkCommonTransforms import vtkTransform
+            matrix = vtkTransform()
+            matrix.RotateWXYZ(angle, *axis)
+            turned.Transform.Rotate = list(matrix.GetOrientation())
+        display = simple.Show(turned, view)
+        display.AmbientColor = display.DiffuseColor = [0.55, 0.55, 0.55]
 
 
 def main():
@@ -97,7 +165,10 @@ def main():
         view.CameraFocalPoint = centre
         view.CameraViewUp = [0.0, 1.0, 0.0]
     else:                            # 3-D: from the front, a little above, z up
-        view.CameraPosition = [centre[0] + 1.0, centre[1] - 2.5, centre[2] + 1.2]
+        if arguments.structures:
+            show_structures(run, view)
+        d = arguments.camera
+        view.CameraPosition = [centre[0] + d[0], centre[1] + d[1], centre[2] + d[2]]
         view.CameraFocalPoint = centre
         view.CameraViewUp = [0.0, 0.0, 1.0]
     view.ResetCamera()

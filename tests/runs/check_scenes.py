@@ -4,7 +4,8 @@ floating_block.nml) and of the debris scenes (debris_column_2d.nml, debris_colum
 files themselves with only the end time, the output folder and (debris: a smoke run in Debug) the cell
 size changed (scripts/scene_variant.py), and checked for: mass conservation, the inflow mass flux
 rho v0 H (within 1 %, and layer by layer), no particle behind a wall, unique ids, a block that stays
-intact, and no debris particle inside the column.
+intact, and no debris particle inside the column; the 3-D showcase debris_impact_3d.nml coarse
+(h = 0.05 m) for 0.03 s: its container is one rigid body in bodies.csv, the column is in loads.csv.
 The full reproductions are scripts/paper_figures.py (CTest label validation).
 
 usage: check_scenes.py <flotsam> <mpiexec> <tests/runs/scenes> <scripts folder>"""
@@ -138,7 +139,49 @@ def main():
             front = x[block, 0].mean() + 0.075
             checks.check(front > 1.9, f"{name}: the surge carries the block to the column", f"front at {front:.3f} m")
 
+    check_debris_impact(checks, flotsam, inputs)
     sys.exit(checks.summary())
+
+
+def check_debris_impact(checks, flotsam, inputs):
+    """The showcase debris_impact_3d.nml, smoke run: h = 0.05 m (twice the scene's, an eighth of its
+    particles) for 0.03 s on 2 ranks. It starts, keeps its mass, and writes what the scene is for: the
+    container in bodies.csv (one rigid body: its particles keep their distances to round-off, it rests
+    on the floor until the bore comes) and the column's force and moment in loads.csv."""
+    import pandas
+    rows, folder = run(checks, flotsam, inputs, "debris_impact_3d.nml", "impact3d", 2,
+                       {"run": {"end_time": "0.03", "output_interval": "0.015", "particle_fields": "'all'"},
+                        "grid": {"cell_size": "0.05"}})
+    if not rows:
+        return
+    mass = [float(r["total_mass"]) for r in rows]
+    checks.close(mass[-1], mass[0], 1e-12, "impact3d: mass kept")
+    bodies = pandas.read_csv(os.path.join(folder, "bodies.csv"), comment="#")
+    loads = pandas.read_csv(os.path.join(folder, "loads.csv"), comment="#")
+    wanted = [f"container_{c}" for c in ("x", "y", "z", "vx", "vy", "vz", "rx", "ry", "rz", "fx", "fy", "fz")]
+    checks.check(set(wanted) <= set(bodies.columns) and not any(c.startswith("reservoir_") for c in bodies.columns),
+                 "impact3d: bodies.csv has the container (and not the water)", str(list(bodies.columns)))
+    checks.check({f"column_{c}" for c in ("fx", "fy", "fz", "mx", "my", "mz")} <= set(loads.columns),
+                 "impact3d: loads.csv has the column's force and moment", str(list(loads.columns)))
+    if "container_z" in bodies.columns:
+        # 0.15 m high on the floor: its centroid at 0.075 m, held there by the floor's contact
+        drift = (bodies["container_z"] - 0.075).abs().max()
+        checks.check(drift < 1e-3, "impact3d: the container rests on the floor before the bore", f"{drift:.2e} m")
+    first = final_particles(folder, rows[:1])
+    last = final_particles(folder, rows)
+    ids = {}
+    for label, state in (("first", first), ("last", last)):
+        box = state["material"] == 2
+        order = np.argsort(state["id"][box])
+        ids[label] = state["position"][box][order]
+    a, b = ids["first"], ids["last"]
+    rigid = len(a) == len(b) and len(a) > 0
+    if rigid:
+        # distances of every particle to two others: unchanged by a rigid motion
+        change = max(np.abs(np.linalg.norm(a - a[k], axis=1) - np.linalg.norm(b - b[k], axis=1)).max()
+                     for k in (0, len(a) - 1))
+        rigid = change < 1e-9
+    checks.check(rigid, "impact3d: the container moves as one rigid body", f"{len(a)} particles")
 
 
 if __name__ == "__main__":
