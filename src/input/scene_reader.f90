@@ -150,6 +150,10 @@ module scene_reader
       variable_info_t('wall', 'friction', 'real', .false.), &
       variable_info_t('wall', 'name', 'string', .false.), &
       variable_info_t('wall', 'moment_point', 'real3', .false.), &
+      variable_info_t('wall', 'motion', 'string', .false.), &
+      variable_info_t('wall', 'motion_start', 'real', .false.), &
+      variable_info_t('wall', 'wave_height', 'real', .false.), &
+      variable_info_t('wall', 'water_depth', 'real', .false.), &
       variable_info_t('inlet', 'name', 'string', .false.), &
       variable_info_t('inlet', 'material', 'string', .true.), &
       variable_info_t('inlet', 'point', 'real3', .true.), &
@@ -1121,9 +1125,11 @@ contains
       integer, intent(out) :: ios
       character(len=*), intent(inout) :: message
       character(len=*), intent(in) :: text
-      character(len=text_len) :: condition, name
-      real(rp) :: point(3), normal(3), lower(3), upper(3), moment_point(3), friction
-      namelist /wall/ point, normal, lower, upper, condition, friction, name, moment_point
+      character(len=text_len) :: condition, name, motion
+      real(rp) :: point(3), normal(3), lower(3), upper(3), moment_point(3), friction, motion_start, wave_height, &
+                  water_depth
+      namelist /wall/ point, normal, lower, upper, condition, friction, name, moment_point, motion, motion_start, &
+         wave_height, water_depth
 
       point = spec%point
       normal = spec%normal
@@ -1133,10 +1139,18 @@ contains
       friction = spec%friction
       name = spec%name
       moment_point = spec%moment_point
+      motion = spec%motion
+      motion_start = spec%motion_start
+      wave_height = spec%wave_height
+      water_depth = spec%water_depth
       read (text, nml=wall, iostat=ios, iomsg=message)
       call take_text('condition', condition, spec%condition, ios, message, fold='lower')
       call take_text('name', name, spec%name, ios, message)
+      call take_text('motion', motion, spec%motion, ios, message, fold='lower')
       if (ios /= 0) return
+      spec%motion_start = motion_start
+      spec%wave_height = wave_height
+      spec%water_depth = water_depth
       spec%point = point
       spec%normal = normal
       spec%lower = lower

@@ -344,6 +344,14 @@ contains
             text = quoted(wall%name)
          case ('moment_point')
             text = reals(wall%moment_point)
+         case ('motion')
+            text = quoted(wall%motion)
+         case ('motion_start')
+            text = real_text(wall%motion_start)
+         case ('wave_height')
+            text = real_text(wall%wave_height)
+         case ('water_depth')
+            text = real_text(wall%water_depth)
          case default
             text = ''
          end select
