@@ -11,8 +11,6 @@
 !> Rank 0 reads the files while it checks the scene (load_body_points); the points travel to the other
 !> ranks with the scene, so every rank seeds from the same numbers.
 module point_file
-   use, intrinsic :: iso_fortran_env, only: iostat_end, iostat_eor, int8
-   use, intrinsic :: iso_c_binding, only: c_char, c_null_char, c_ptr, c_associated
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use hdf5, only: hid_t, hsize_t, h5open_f, h5fopen_f, h5fclose_f, h5dopen_f, h5dclose_f, h5dread_f, &
                    h5dget_space_f, h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, h5sclose_f, &
@@ -22,25 +20,11 @@ module point_file
    use scene_description, only: scene_t, body_points_t
    use input_text, only: int_text, real_text, lower_case, group_context
    use body_lattice, only: has_points_file
+   use csv_table, only: read_csv_columns, numbers_checksum, beside, absolute_path
    implicit none
    private
 
    public :: read_point_file, points_checksum, load_body_points
-
-   interface
-      !> POSIX realpath(3): the absolute path of an existing file, without '.', '..' or links.
-      function c_realpath(path, resolved) bind(c, name='realpath') result(r)
-         import :: c_char, c_ptr
-         character(kind=c_char), intent(in) :: path(*)
-         character(kind=c_char), intent(out) :: resolved(*)
-         type(c_ptr) :: r
-      end function c_realpath
-   end interface
-
-   !> Longest field of a line kept (a number or a column name; a longer field is cut and then not read).
-   integer, parameter :: field_len = 128
-   !> Longest path realpath may write (PATH_MAX of Linux) plus the terminating null.
-   integer, parameter :: c_path_max = 4097
 
 contains
 
@@ -107,32 +91,6 @@ contains
       if (len_trim(name) > 0) detail = "name '"//trim(name)//"', "//detail
    end function body_detail
 
-   !> `path` as seen from the folder of `scene_file` (unchanged if absolute).
-   pure function beside(scene_file, path) result(joined)
-      character(len=*), intent(in) :: scene_file, path
-      character(len=:), allocatable :: joined
-      integer :: slash
-      joined = path
-      if (path(1:1) == '/') return
-      slash = index(scene_file, '/', back=.true.)
-      if (slash > 0) joined = scene_file(1:slash)//path
-   end function beside
-
-   !> The absolute path of an existing file; '' if it does not exist.
-   function absolute_path(path) result(absolute)
-      character(len=*), intent(in) :: path
-      character(len=:), allocatable :: absolute
-      character(kind=c_char) :: buffer(c_path_max)
-      integer :: i
-      absolute = ''
-      buffer = c_null_char
-      if (.not. c_associated(c_realpath(path//c_null_char, buffer))) return
-      do i = 1, c_path_max
-         if (buffer(i) == c_null_char) exit
-         absolute = absolute//buffer(i)
-      end do
-   end function absolute_path
-
    !> Read the points of `path` (CSV or HDF5, by its ending) in a `dim`-dimensional scene: positions
    !> (dim, n) and volumes (n), every point inside lower..upper (to `tolerance`). Messages start with the path.
    subroutine read_point_file(path, dim, lower, upper, tolerance, position, volume, status)
@@ -165,109 +123,28 @@ contains
       real(rp), intent(in) :: lower(dim), upper(dim), tolerance
       real(rp), allocatable, intent(out) :: position(:, :), volume(:)
       type(status_t), intent(inout) :: status
-      character(len=*), parameter :: axis_names(3) = ['x', 'y', 'z']
-      character(len=:), allocatable :: line, where
-      character(len=field_len), allocatable :: fields(:)
-      character(len=512) :: message
-      real(rp), allocatable :: grown(:, :)
-      real(rp) :: values(dim + 1)
-      integer :: unit, ios, line_number, columns(dim + 1), c, k, n
-      logical :: header_read
+      character(len=*), parameter :: names(4) = ['x     ', 'y     ', 'z     ', 'volume']
+      real(rp), allocatable :: values(:, :)
+      integer, allocatable :: line(:)
+      integer :: p
 
       allocate (position(dim, 0), volume(0))
-      allocate (character(len=0) :: where, line)
-      open (newunit=unit, file=path, status='old', action='read', form='formatted', access='sequential', &
-            iostat=ios, iomsg=message)
-      if (ios /= 0) then
-         call status%fail(path//': cannot open the file: '//trim(message))
+      call read_csv_columns(path, [names(1:dim), names(4)], 'points', values, line, status)
+      if (.not. status%ok) return
+      if (size(values, 2) == 0) then
+         call status%fail(path//': no points after the header line')
          return
       end if
-      allocate (grown(dim + 1, 1024))
-      n = 0
-      line_number = 0
-      header_read = .false.
-      do
-         call read_line(unit, line, ios, message)
-         if (ios == iostat_end) exit
-         line_number = line_number + 1
-         where = path//': line '//int_text(line_number)
-         if (ios /= 0) then
-            call status%fail(where//': cannot read the file: '//trim(message))
-            exit
-         end if
-         if (len_trim(line) == 0) cycle
-         if (line(verify(line, ' '):verify(line, ' ')) == '#') cycle
-         call split_fields(line, fields)
-         if (.not. header_read) then
-            header_read = .true.
-            do k = 1, dim + 1
-               if (k <= dim) then
-                  columns(k) = find_column(fields, axis_names(k))
-               else
-                  columns(k) = find_column(fields, 'volume')
-               end if
-               if (columns(k) == 0) then
-                  call status%fail(where//': the header names no column '//trim(header_name(k, dim))// &
-                                   ' (it must name x, y'//trim(merge(', z', '   ', dim == 3))//' and volume)')
-                  exit
-               end if
-            end do
-            if (.not. status%ok) exit
-            cycle
-         end if
-         if (size(fields) < maxval(columns)) then
-            call status%fail(where//': '//int_text(size(fields))//' values, the header names '// &
-                             int_text(maxval(columns))//' columns')
-            exit
-         end if
-         do k = 1, dim + 1
-            c = columns(k)
-            if (.not. read_number(fields(c), values(k))) then
-               call status%fail(where//': column '//trim(header_name(k, dim))//": '"//trim(fields(c))// &
-                                "' is not a finite number")
-               exit
-            end if
-         end do
-         if (.not. status%ok) exit
-         call check_point(where, values(1:dim), values(dim + 1), lower, upper, tolerance, status)
-         if (.not. status%ok) exit
-         if (n == size(grown, 2)) call grow(grown)
-         n = n + 1
-         grown(:, n) = values
+      do p = 1, size(values, 2)
+         call check_point(path//': line '//int_text(line(p)), values(1:dim, p), values(dim + 1, p), lower, upper, &
+                          tolerance, status)
+         if (.not. status%ok) return
       end do
-      close (unit)
-      if (.not. status%ok) return
-      if (.not. header_read) then
-         call status%fail(path//': no header line (x, y'//trim(merge(', z', '   ', dim == 3))//', volume) and no points')
-      else if (n == 0) then
-         call status%fail(path//': no points after the header line')
-      end if
-      if (.not. status%ok) return
       deallocate (position, volume)
-      allocate (position(dim, n), volume(n))
-      position = grown(1:dim, 1:n)
-      volume = grown(dim + 1, 1:n)
+      allocate (position(dim, size(values, 2)), volume(size(values, 2)))
+      position = values(1:dim, :)
+      volume = values(dim + 1, :)
    end subroutine read_csv_points
-
-   pure function header_name(k, dim) result(name)
-      integer, intent(in) :: k, dim
-      character(len=6) :: name
-      character(len=*), parameter :: axis_names(3) = ['x', 'y', 'z']
-      if (k <= dim) then
-         name = axis_names(k)
-      else
-         name = 'volume'
-      end if
-   end function header_name
-
-   !> Double the capacity of the points read so far.
-   subroutine grow(values)
-      real(rp), allocatable, intent(inout) :: values(:, :)
-      real(rp), allocatable :: larger(:, :)
-      allocate (larger(size(values, 1), 2 * size(values, 2)))
-      larger(:, 1:size(values, 2)) = values
-      call move_alloc(larger, values)
-   end subroutine grow
 
    !> A point must be finite, of positive volume and inside the scene box lower..upper.
    subroutine check_point(where, x, volume, lower, upper, tolerance, status)
@@ -288,80 +165,6 @@ contains
          end if
       end do
    end subroutine check_point
-
-   !> One line of any length (without its line break; a trailing carriage return removed).
-   subroutine read_line(unit, line, ios, message)
-      integer, intent(in) :: unit
-      character(len=:), allocatable, intent(out) :: line
-      integer, intent(out) :: ios
-      character(len=*), intent(inout) :: message
-      character(len=256) :: chunk
-      integer :: nread
-      line = ''
-      do
-         read (unit, '(a)', advance='no', iostat=ios, iomsg=message, size=nread) chunk
-         if (ios == 0 .or. ios == iostat_eor) line = line//chunk(1:nread)
-         if (ios == 0) cycle
-         if (ios == iostat_eor) ios = 0
-         ! end of file after a last line without a line break: that line still counts
-         if (ios == iostat_end .and. len(line) > 0) ios = 0
-         exit
-      end do
-      if (len(line) > 0) then
-         if (line(len(line):len(line)) == achar(13)) line = line(1:len(line) - 1)
-      end if
-   end subroutine read_line
-
-   !> The comma-separated fields of a line, blanks and one pair of double quotes around each removed.
-   pure subroutine split_fields(line, fields)
-      character(len=*), intent(in) :: line
-      character(len=field_len), allocatable, intent(out) :: fields(:)
-      integer :: n, start, comma, k
-      character(len=:), allocatable :: field
-      n = count([(line(k:k) == ',', k=1, len(line))]) + 1
-      allocate (fields(n))
-      start = 1
-      do k = 1, n
-         comma = index(line(start:), ',')
-         if (comma == 0) then
-            field = trim(adjustl(line(start:)))
-         else
-            field = trim(adjustl(line(start:start + comma - 2)))
-            start = start + comma
-         end if
-         if (len(field) >= 2) then
-            if (field(1:1) == '"' .and. field(len(field):len(field)) == '"') field = field(2:len(field) - 1)
-         end if
-         fields(k) = field
-      end do
-   end subroutine split_fields
-
-   !> Position of the column called `name` (any case); 0 if none.
-   pure integer function find_column(fields, name) result(found)
-      character(len=*), intent(in) :: fields(:), name
-      integer :: k
-      found = 0
-      do k = 1, size(fields)
-         if (lower_case(trim(fields(k))) == name) then
-            found = k
-            return
-         end if
-      end do
-   end function find_column
-
-   !> A decimal number as pandas writes it (digits, sign, point, exponent e), and finite.
-   logical function read_number(text, value) result(ok)
-      character(len=*), intent(in) :: text
-      real(rp), intent(out) :: value
-      integer :: ios
-      value = 0.0_rp
-      ok = len_trim(text) > 0 .and. verify(trim(text), '0123456789+-.eE') == 0 .and. &
-           scan(trim(text), '0123456789') > 0
-      if (.not. ok) return
-      read (text, *, iostat=ios) value
-      ok = ios == 0
-      if (ok) ok = ieee_is_finite(value)
-   end function read_number
 
    !> Datasets `position` and `volume` of an HDF5 file (at the root or in group `particles`).
    subroutine read_hdf5_points(path, dim, lower, upper, tolerance, position, volume, status)
@@ -488,35 +291,14 @@ contains
       call h5dclose_f(dataset, error)
    end subroutine read_dataset
 
-   !> 16 hex digits of two 32-bit FNV-1a hashes (different offsets) over the bytes of the positions and
-   !> volumes: a file whose points change gets another checksum (a change detector, not a signature).
+   !> The checksum (csv_table numbers_checksum) of the points in the order x, y[, z], volume per point.
    function points_checksum(position, volume) result(text)
       real(rp), intent(in) :: position(:, :), volume(:)
       character(len=16) :: text
-      integer(i8), parameter :: prime = 16777619_i8, modulus = 4294967296_i8
-      integer(i8) :: h(2)
-      integer :: p
-      h = [2166136261_i8, 3735928559_i8]
-      do p = 1, size(volume)
-         call add_values(position(:, p))
-         call add_values([volume(p)])
-      end do
-      write (text, '(2z8.8)') h(1), h(2)
-      text = lower_case(text)
-
-   contains
-
-      subroutine add_values(values)
-         real(rp), intent(in) :: values(:)
-         integer(int8) :: bytes(8)
-         integer :: v, k
-         do v = 1, size(values)
-            bytes = transfer(values(v), bytes)
-            do k = 1, 8
-               ! h < 2^32 and prime < 2^25: the product fits 64 bits
-               h = mod(ieor(h, iand(int(bytes(k), i8), 255_i8)) * prime, modulus)
-            end do
-         end do
-      end subroutine add_values
+      real(rp), allocatable :: rows(:, :)
+      allocate (rows(size(position, 1) + 1, size(volume)))
+      rows(1:size(position, 1), :) = position(:, 1:size(volume))
+      rows(size(position, 1) + 1, :) = volume
+      text = numbers_checksum(rows)
    end function points_checksum
 end module point_file
