@@ -33,6 +33,7 @@ module boundary_walls
    use background_grid, only: grid_t
    use particle_set, only: particle_set_t
    use wall_motion, only: wall_motion_t, motion_of_wall
+   use time_table, only: time_table_t
    implicit none
    private
 
@@ -102,19 +103,24 @@ contains
    !> The walls of `&wall` groups (`specs`) and of the `&box_walls` sides of `spec`, with their local nodes.
    !> With `gravity` (world frame) and `time`, a `&wall` with a motion moves (the solitary stroke needs g)
    !> and is placed where it is at `time`.
-   subroutine build_walls(specs, spec, grid, walls, gravity, time)
+   subroutine build_walls(specs, spec, grid, walls, gravity, time, tables)
       type(wall_spec_t), intent(in) :: specs(:)
       type(grid_spec_t), intent(in) :: spec
       type(grid_t), intent(in) :: grid
       type(wall_t), allocatable, intent(out) :: walls(:)
       real(rp), intent(in), optional :: gravity(3), time
+      type(time_table_t), intent(in), optional :: tables(:)   !< per spec, the table of a 'table' motion
       type(wall_spec_t), allocatable :: all_specs(:)
       integer :: w
       all_specs = [specs, box_side_walls(spec)]
       call build_walls_of(all_specs, grid, walls)
       if (.not. (present(gravity) .and. present(time))) return
       do w = 1, size(specs)
-         walls(w)%motion = motion_of_wall(specs(w), gravity, grid%dim)
+         if (present(tables)) then
+            walls(w)%motion = motion_of_wall(specs(w), gravity, grid%dim, tables(w))
+         else
+            walls(w)%motion = motion_of_wall(specs(w), gravity, grid%dim)
+         end if
          if (.not. walls(w)%motion%moving()) cycle
          walls(w)%moving = .true.
          walls(w)%rest_point = specs(w)%point

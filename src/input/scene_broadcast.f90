@@ -71,6 +71,7 @@ contains
       if (rank /= root) call resize(bytes, n)
       call MPI_Bcast(bytes, n, MPI_CHARACTER, root, comm)
       call broadcast_body_points(scene, counts(2), comm, root, rank)
+      call broadcast_wall_tables(scene, counts(3), comm, root, rank)
       if (rank == root) return
 
       at = 1
@@ -136,6 +137,41 @@ contains
          end associate
       end do
    end subroutine broadcast_body_points
+
+   !> The tables of the walls that move by a table (scene%wall_tables, allocatable arrays): per wall the
+   !> numbers of value columns and rows (-1: none), then the times and values, the path and checksum.
+   subroutine broadcast_wall_tables(scene, walls, comm, root, rank)
+      type(scene_t), intent(inout) :: scene
+      integer, intent(in) :: walls, root, rank
+      type(MPI_Comm), intent(in) :: comm
+      integer :: w, shape(2)
+      logical :: has_tables
+      if (walls < 0) return
+      has_tables = allocated(scene%wall_tables)
+      call MPI_Bcast(has_tables, 1, MPI_LOGICAL, root, comm)
+      if (.not. has_tables) then
+         if (allocated(scene%wall_tables)) deallocate (scene%wall_tables)
+         return
+      end if
+      if (rank /= root) then
+         if (allocated(scene%wall_tables)) deallocate (scene%wall_tables)
+         allocate (scene%wall_tables(walls))
+      end if
+      do w = 1, walls
+         associate (table => scene%wall_tables(w))
+            shape = -1
+            if (rank == root .and. allocated(table%values)) shape = [size(table%values, 1), size(table%values, 2)]
+            call MPI_Bcast(shape, 2, MPI_INTEGER, root, comm)
+            if (shape(1) < 0) cycle
+            if (rank /= root) allocate (table%values(shape(1), shape(2)), table%time(shape(2)), table%columns(shape(1)))
+            call MPI_Bcast(table%time, size(table%time), MPI_DOUBLE_PRECISION, root, comm)
+            call MPI_Bcast(table%values, size(table%values), MPI_DOUBLE_PRECISION, root, comm)
+            call MPI_Bcast(table%columns, len(table%columns) * size(table%columns), MPI_CHARACTER, root, comm)
+            call MPI_Bcast(table%path, len(table%path), MPI_CHARACTER, root, comm)
+            call MPI_Bcast(table%checksum, len(table%checksum), MPI_CHARACTER, root, comm)
+         end associate
+      end do
+   end subroutine broadcast_wall_tables
 
    !> Allocate `bytes` with `n` elements (assigning to an unallocated array first makes gfortran 12
    !> warn falsely about uninitialised bounds).

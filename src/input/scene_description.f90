@@ -3,6 +3,7 @@
 module scene_description
    use kinds, only: rp, i8, path_len, name_len
    use shape_geometry, only: shape_t
+   use time_table, only: time_table_t
    implicit none
    private
 
@@ -104,6 +105,10 @@ module scene_description
       real(rp) :: motion_start = 0.0_rp       !< solitary_wave: the stroke starts [s]
       real(rp) :: wave_height = 0.0_rp        !< solitary_wave: wave height A [m]
       real(rp) :: water_depth = 0.0_rp        !< solitary_wave: still-water depth h [m]
+      !> table: CSV of the displacement (t, x, y[, z]); resolved to an absolute path
+      character(len=path_len) :: motion_file = ''
+      !> table: checksum of the numbers read from motion_file (16 hex digits); given: must match the file
+      character(len=16) :: motion_checksum = ''
    end type wall_spec_t
 
    !> `&structure`: a fixed rigid obstacle of any shape and orientation (world frame) whose surface
@@ -227,6 +232,8 @@ module scene_description
       !> per body, the points of its points_file (read by rank 0, broadcast with the scene)
       type(body_points_t), allocatable :: body_points(:)
       type(wall_spec_t), allocatable :: walls(:)      !< `&wall` groups (the `&box_walls` sides are in grid)
+      !> per wall, the table of its motion_file (read by rank 0, broadcast with the scene; empty otherwise)
+      type(time_table_t), allocatable :: wall_tables(:)
       type(structure_spec_t), allocatable :: structures(:)   !< `&structure` groups
       type(inlet_spec_t), allocatable :: inlets(:)
       type(gauge_spec_t), allocatable :: gauges(:)

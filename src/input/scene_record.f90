@@ -352,6 +352,10 @@ contains
             text = real_text(wall%wave_height)
          case ('water_depth')
             text = real_text(wall%water_depth)
+         case ('motion_file')
+            text = quoted(wall%motion_file)
+         case ('motion_checksum')
+            text = quoted(wall%motion_checksum)
          case default
             text = ''
          end select

@@ -8,7 +8,7 @@ module scene_validation
    use error_status, only: status_t
    use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
                                 inlet_spec_t, gauge_spec_t, contact_spec_t, structure_spec_t, opening_far_end, wall_none, &
-                                wall_slip, wall_no_slip, wall_friction, motion_none, motion_solitary_wave, &
+                                wall_slip, wall_no_slip, wall_friction, motion_none, motion_solitary_wave, motion_table, &
                                 model_newtonian_fluid, model_linear_elastic, gauge_pressure, gauge_level, gauge_velocity, &
                                 particle_field_names, field_precision_keywords
    use input_text, only: int_text, real_text, quoted_list, group_context, ordinal
@@ -55,7 +55,7 @@ module scene_validation
    character(len=*), parameter, public :: transfer_keywords(*) = [character(len=8) :: 'flip_pic', 'apic']
    !> Accepted `&wall motion=` keywords (stored lower case).
    character(len=*), parameter, public :: motion_keywords(*) = [character(len=13) :: motion_none, &
-                                                                motion_solitary_wave]
+                                                                motion_solitary_wave, motion_table]
    !> Largest solitary wave height over depth a wall may make (solitary waves break near A/h = 0.78;
    !> Goring's first-order stroke is poor beyond about 0.6).
    real(rp), parameter :: max_wave_ratio = 0.6_rp
@@ -1154,7 +1154,19 @@ contains
          if (wall%water_depth /= 0.0_rp) call refuse('water_depth')
       end if
       if (wall%motion == motion_none .and. wall%motion_start /= 0.0_rp) call refuse('motion_start')
-      if (.not. status%ok .or. wall%motion == motion_none) return
+      if (wall%motion /= motion_table) then
+         if (len_trim(wall%motion_file) > 0) call refuse('motion_file')
+         if (len_trim(wall%motion_checksum) > 0) call refuse('motion_checksum')
+      else if (len_trim(wall%motion_file) == 0) then
+         call status%fail(where//": variable motion_file is required with motion = '"//motion_table// &
+                          "' (a CSV of t, x, y[, z]: the wall's displacement)")
+      end if
+      if (wall%motion == motion_table .and. wall%motion_start /= 0.0_rp) then
+         call status%fail(where//": variable motion_start belongs to motion = '"//motion_solitary_wave// &
+                          "' (a table gives its own times)")
+      end if
+      ! a table is checked against the scene box when it is read (load_wall_tables)
+      if (.not. status%ok .or. wall%motion == motion_none .or. wall%motion == motion_table) return
       call check_real(where, 'motion_start', wall%motion_start, status, at_least=0.0_rp)
       if (.not. status%ok) return
       if (wall%motion == motion_solitary_wave) then
@@ -1190,6 +1202,8 @@ contains
          ! motion_start belongs to every motion, the others to the solitary wave
          owner = "motion = '"//motion_solitary_wave//"'"
          if (variable == 'motion_start') owner = 'a motion'
+         if (variable(1:min(7, len(variable))) == 'motion_' .and. variable /= 'motion_start') &
+            owner = "motion = '"//motion_table//"'"
          call status%fail(where//': variable '//variable//' belongs to '//owner//", which is not given (motion = '"// &
                           trim(wall%motion)//"')")
       end subroutine refuse

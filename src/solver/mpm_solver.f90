@@ -214,7 +214,12 @@ contains
       type(wall_spec_t), allocatable :: no_walls(:)
       integer :: entries
       if (allocated(self%scene%walls)) then
-         call build_walls(self%scene%walls, self%scene%grid, self%grid, self%walls, self%scene%gravity, self%time)
+         if (allocated(self%scene%wall_tables)) then
+            call build_walls(self%scene%walls, self%scene%grid, self%grid, self%walls, self%scene%gravity, self%time, &
+                             self%scene%wall_tables)
+         else
+            call build_walls(self%scene%walls, self%scene%grid, self%grid, self%walls, self%scene%gravity, self%time)
+         end if
       else
          allocate (no_walls(0))
          call build_walls(no_walls, self%scene%grid, self%grid, self%walls)
