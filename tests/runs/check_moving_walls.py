@@ -17,11 +17,15 @@
    (mass h1 (s - U) = h s, momentum), which is rho g h^2 / 2 + rho h1 U s: the hydrostatic force plus
    the momentum flux (docs/loads.md). Within 3 %.
 
-Default (the default suite): the solitary wave A/h = 0.3 at 8 cells per depth with FOAL1 (speed 3 %,
-height 10 %) and the piston. --long (label validation): A/h = 0.1, 0.2, 0.3 at 16 cells per depth
-with FOAL1, and A/h = 0.1, 0.3 with standard MPM and C0 (the height loss per scheme).
+3. Restart and ranks (default mode): the piston stopped at step 610 and continued from its step-600
+   checkpoint writes loads.csv and gauges.csv byte for byte; 1 and 2 ranks agree to 1e-10.
 
-usage: check_moving_walls.py <flotsam> <mpiexec> <inputs folder> <tests/runs/scenes> [--long]
+Default (the default suite): the solitary wave A/h = 0.3 at 8 cells per depth (standard MPM, pure FLIP:
+speed 3 %, height 10 %, profile), the piston, restart and ranks. --long (label validation): A/h = 0.1,
+0.2, 0.3 at 16 cells per depth (standard MPM, pure FLIP; checked), and A/h = 0.1, 0.3 with the default
+PIC blend (flip_fraction 0.95), FOAL1 and C0 (the height loss per scheme, printed).
+
+usage: check_moving_walls.py <flotsam> <mpiexec> <tests/runs/scenes> [<scripts folder>] [--long]
                              [--figures DIR] [--ranks N] [--analyse OUTPUT_FOLDER --ratio A/h]"""
 
 import argparse
@@ -155,16 +159,12 @@ def run_wave(checks, flotsam, inputs, ranks, ratio, scheme, cell, figures, stric
     name = f"solitary_{ratio:g}_{scheme}_{cell:g}_{flip:g}".replace(".", "p")
     flotsam.remove(name)
     path = flotsam.scene(os.path.join(inputs, "solitary_wave.nml"), name + ".nml", name, end_time=end,
-                         load_interval=0.002)
-    with open(path) as f:
-        text = f.read()
-    text += (f"\n&material name = 'water', stabilization = '{scheme}' /\n&grid cell_size = {cell} /\n"
-             f"&run flip_fraction = {flip} /\n"
-             f"&wall name = 'paddle', wave_height = {amplitude:.6g} /\n")
-    with open(path, "w") as f:
-        f.write(text)
+                         load_interval=0.002, flip_fraction=flip)
     start = time.time()
-    process = flotsam.run(path, ranks, "--overwrite", timeout=7200)
+    process = flotsam.run(path, ranks, "--overwrite",
+                          "--set", f"&material name = 'water', stabilization = '{scheme}' /",
+                          "--set", f"&grid cell_size = {cell} /",
+                          "--set", f"&wall name = 'paddle', wave_height = {amplitude:.6g} /", timeout=7200)
     seconds = time.time() - start
     label = f"A/h = {ratio:g}, {scheme}, flip {flip:g}, h/{H / cell:.0f}"
     if not checks.check(process.returncode == 0, f"{label}: run on {ranks} ranks ({seconds:.0f} s)",
@@ -250,12 +250,67 @@ def check_piston(checks, flotsam, scenes, ranks, figures):
         print(f"     figure: {path}", flush=True)
 
 
+def check_restart_and_ranks(checks, flotsam_path, mpiexec, scenes):
+    """The piston to t = 0.6 s on 2 ranks, checkpoints every 300 steps; again stopped at step 610 and
+    continued from the step-600 checkpoint: loads.csv and gauges.csv rows byte for byte. And the same on 1
+    rank: loads within 1e-10 relative (of the largest force)."""
+    import glob
+    import h5py
+    folder = os.path.join(scenes, "moving_walls")
+    runs = {}
+    for name, ranks, extra in (("full", 2, ""), ("split", 2, "\n   max_steps = 610"), ("one", 1, "")):
+        flotsam = Flotsam(flotsam_path, mpiexec, f"restart_{name}")
+        flotsam.remove("out")
+        with open(os.path.join(folder, "piston.nml")) as f:
+            text = f.read()
+        text = text.replace("output_dir = 'output/piston'", "output_dir = 'out'")
+        start = text.index("&run")
+        end = text.index("\n/", start)
+        text = text[:end] + "\n   end_time = 0.6\n   checkpoint_interval_steps = 300" + extra + text[end:]
+        with open(flotsam.path("scene.nml"), "w") as f:
+            f.write(text)
+        with open(os.path.join(folder, "piston.csv")) as source, open(flotsam.path("piston.csv"), "w") as copy:
+            copy.write(source.read())
+        result = flotsam.run("scene.nml", ranks)
+        if not checks.check(result.returncode == 0, f"restart: the {name} run on {ranks} ranks", result.stderr[-2000:]):
+            return
+        runs[name] = flotsam
+    split = runs["split"]
+    checkpoint = None
+    for path in sorted(glob.glob(split.path("out", "checkpoints", "checkpoint_*.h5"))):
+        with h5py.File(path) as f:
+            if int(f.attrs["step"]) == 600:
+                checkpoint = os.path.relpath(path, split.workdir)
+    if not checks.check(checkpoint is not None, "restart: a checkpoint at step 600"):
+        return
+    with open(split.path("scene.nml")) as f:
+        text = f.read().replace("\n   max_steps = 610", "")
+    with open(split.path("continue.nml"), "w") as f:
+        f.write(text)
+    result = split.run("continue.nml", 2, "--restart", checkpoint)
+    checks.check(result.returncode == 0, "restart: continued from step 600", result.stderr[-2000:])
+    for file in ("loads", "gauges"):
+        rows = {}
+        for name in ("full", "split"):
+            with open(runs[name].path("out", file + ".csv")) as f:
+                rows[name] = [line for line in f.read().splitlines() if not line.startswith("#")]
+        checks.check(rows["full"] == rows["split"] and len(rows["full"]) > 10,
+                     f"restart: {file}.csv rows byte for byte ({len(rows['full'])} lines)",
+                     f"{len(rows['split'])} lines against {len(rows['full'])}")
+    two = pd.read_csv(runs["full"].path("out", "loads.csv"), comment="#")
+    one = pd.read_csv(runs["one"].path("out", "loads.csv"), comment="#")
+    scale = float(np.abs(two.drop(columns="time").to_numpy()).max())
+    deviation = float(np.abs(two.drop(columns="time").to_numpy() - one.drop(columns="time").to_numpy()).max())
+    checks.check(deviation <= 1e-10 * scale, f"ranks: loads.csv on 1 and 2 ranks agree to {deviation / scale:.1e} "
+                 "of the largest force", f"{deviation / scale:.2e}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("flotsam", nargs="?")
     parser.add_argument("mpiexec", nargs="?")
-    parser.add_argument("inputs", nargs="?", help="the inputs folder (solitary_wave.nml)")
     parser.add_argument("scenes", nargs="?", help="tests/runs/scenes")
+    parser.add_argument("scripts", nargs="?", help="scripts folder (its sibling inputs/ has solitary_wave.nml)")
     parser.add_argument("--long", action="store_true")
     parser.add_argument("--figures", default=None)
     parser.add_argument("--ranks", type=int, default=2)
@@ -272,7 +327,8 @@ def main():
             draw_wave(result, os.path.join(arguments.figures, "solitary_wave.png"))
         return checks.summary()
     flotsam = Flotsam(arguments.flotsam, arguments.mpiexec, "output")
-    inputs = os.path.abspath(arguments.inputs)
+    scripts = arguments.scripts or os.path.join(os.path.dirname(__file__), "..", "..", "scripts")
+    inputs = os.path.abspath(os.path.join(scripts, "..", "inputs"))
     figures = os.path.abspath(arguments.figures) if arguments.figures else None
     scenes = os.path.abspath(arguments.scenes)
     started = time.time()
@@ -290,6 +346,8 @@ def main():
         run_wave(checks, flotsam, inputs, arguments.ranks, 0.3, "none", 0.0125, figures)
     if not arguments.only_wave:
         check_piston(checks, flotsam, scenes, arguments.ranks, figures)
+        if not arguments.long:
+            check_restart_and_ranks(checks, arguments.flotsam, arguments.mpiexec, scenes)
     print(f"total {time.time() - started:.0f} s", flush=True)
     return checks.summary()
 
