@@ -17,6 +17,9 @@
 !>   no_slip    v := 0
 !>   prescribed v := v_0 (the feeder of an inlet, algorithms.md section 4.3)
 !> A wall may be active for a time window only (an inlet's opening and its closing wall).
+!> A `&wall` may move (wall_motion, docs/theory.md section 3.6): each step it is placed where its motion
+!> puts it at the step's start, its node list is rebuilt there, and the constraints act on the velocity
+!> relative to the wall's mean velocity v_w over the step; the safeguard uses its place at the step's end.
 !>
 !> Loads (docs/theory.md section 3.2, algorithms.md section 9.1): the constraint's change of nodal
 !> momentum m_i (v_i^c - v_i^*) and the safeguard's change of particle momentum m_p (v_p^c - v_p) are the
@@ -29,6 +32,8 @@ module boundary_walls
    use shape_geometry, only: shape_t, shape_distance, shape_normal, shape_bounds
    use background_grid, only: grid_t
    use particle_set, only: particle_set_t
+   use wall_motion, only: wall_motion_t, motion_of_wall
+   use time_table, only: time_table_t
    implicit none
    private
 
@@ -68,6 +73,13 @@ module boundary_walls
       !> shaped: grid-frame bounding box of the shape (the safeguard's quick rejection)
       real(rp) :: box_lower(3) = -huge(1.0_rp), box_upper(3) = huge(1.0_rp)
       real(rp), allocatable :: node_normal(:, :)   !< shaped: unit normal at node nodes(i) (dim, i), grid frame
+      !> a moving wall: its motion, its point and extent in the scene (world frame), the grid-frame point its
+      !> node list was built at, and its mean velocity over the current step (grid frame)
+      logical :: moving = .false.
+      type(wall_motion_t) :: motion
+      real(rp) :: rest_point(3) = 0.0_rp, rest_lower(3) = 0.0_rp, rest_upper(3) = 0.0_rp
+      real(rp) :: nodes_point(3) = 0.0_rp
+      real(rp) :: wall_velocity(3) = 0.0_rp
    end type wall_t
 
    !> Rows of an impulse accumulator (impulse_rows, wall): force impulse (3), then moment impulse (3), grid frame.
@@ -75,7 +87,7 @@ module boundary_walls
 
    public :: build_walls, box_side_walls, make_wall, make_structure, build_structures, set_wall_activity, &
              apply_wall_constraints, keep_particles_inside, behind_wall, wall_distance, unilateral_velocity, &
-             first_particle_inside, surface_normal
+             first_particle_inside, surface_normal, move_walls, place_moving_walls, moving_wall_speed
 
 contains
 
@@ -89,14 +101,35 @@ contains
    end function wall_depth_in_cells
 
    !> The walls of `&wall` groups (`specs`) and of the `&box_walls` sides of `spec`, with their local nodes.
-   subroutine build_walls(specs, spec, grid, walls)
+   !> With `gravity` (world frame) and `time`, a `&wall` with a motion moves (the solitary stroke needs g)
+   !> and is placed where it is at `time`.
+   subroutine build_walls(specs, spec, grid, walls, gravity, time, tables)
       type(wall_spec_t), intent(in) :: specs(:)
       type(grid_spec_t), intent(in) :: spec
       type(grid_t), intent(in) :: grid
       type(wall_t), allocatable, intent(out) :: walls(:)
+      real(rp), intent(in), optional :: gravity(3), time
+      type(time_table_t), intent(in), optional :: tables(:)   !< per spec, the table of a 'table' motion
       type(wall_spec_t), allocatable :: all_specs(:)
+      integer :: w
       all_specs = [specs, box_side_walls(spec)]
       call build_walls_of(all_specs, grid, walls)
+      if (.not. (present(gravity) .and. present(time))) return
+      do w = 1, size(specs)
+         if (present(tables)) then
+            walls(w)%motion = motion_of_wall(specs(w), gravity, grid%dim, tables(w))
+         else
+            walls(w)%motion = motion_of_wall(specs(w), gravity, grid%dim)
+         end if
+         if (.not. walls(w)%motion%moving()) cycle
+         walls(w)%moving = .true.
+         walls(w)%rest_point = specs(w)%point
+         walls(w)%rest_lower = specs(w)%lower
+         walls(w)%rest_upper = specs(w)%upper
+         walls(w)%nodes_point = walls(w)%point
+      end do
+      call place_moving_walls(walls, grid, time)
+      call refresh_moving_walls(walls, grid)
    end subroutine build_walls
 
    subroutine build_walls_of(specs, grid, walls)
@@ -112,6 +145,112 @@ contains
          walls(w)%friction = specs(w)%friction
       end do
    end subroutine build_walls_of
+
+   !> Put every moving wall where its motion has it at `time` (point and extent); the node lists are
+   !> left as they are (refresh_moving_walls).
+   subroutine place_moving_walls(walls, grid, time)
+      type(wall_t), intent(inout) :: walls(:)
+      type(grid_t), intent(in) :: grid
+      real(rp), intent(in) :: time
+      integer :: w, dim
+      real(rp) :: d(3)
+      dim = grid%dim
+      do w = 1, size(walls)
+         if (.not. walls(w)%moving) cycle
+         d = walls(w)%motion%displacement(time)
+         walls(w)%point(1:dim) = grid%frame%grid_point(walls(w)%rest_point(1:dim) + d(1:dim))
+         ! an unbounded side stays unbounded (huge + d rounds to huge)
+         walls(w)%lower(1:dim) = walls(w)%rest_lower(1:dim) + d(1:dim)
+         walls(w)%upper(1:dim) = walls(w)%rest_upper(1:dim) + d(1:dim)
+      end do
+   end subroutine place_moving_walls
+
+   !> Step t0 -> t1: every moving wall placed at t0, its node list rebuilt if it moved since the list was
+   !> made, and its velocity the mean over the step (the constraint's v_w).
+   subroutine move_walls(walls, grid, t0, t1)
+      type(wall_t), intent(inout) :: walls(:)
+      type(grid_t), intent(in) :: grid
+      real(rp), intent(in) :: t0, t1
+      integer :: w, dim
+      real(rp) :: v(3)
+      dim = grid%dim
+      call place_moving_walls(walls, grid, t0)
+      call refresh_moving_walls(walls, grid)
+      do w = 1, size(walls)
+         if (.not. walls(w)%moving) cycle
+         v = walls(w)%motion%mean_velocity(t0, t1)
+         walls(w)%wall_velocity = 0.0_rp
+         walls(w)%wall_velocity(1:dim) = grid%frame%grid_vector(v(1:dim))
+      end do
+   end subroutine move_walls
+
+   !> The largest speed of the moving walls over [t0, t1] [m/s] (0 without any).
+   real(rp) function moving_wall_speed(walls, t0, t1) result(speed)
+      type(wall_t), intent(in) :: walls(:)
+      real(rp), intent(in) :: t0, t1
+      integer :: w
+      speed = 0.0_rp
+      do w = 1, size(walls)
+         if (walls(w)%moving) speed = max(speed, walls(w)%motion%max_speed(t0, t1))
+      end do
+   end function moving_wall_speed
+
+   !> Rebuild the node list of each moving wall whose point differs from the one its list was built at.
+   !> Only the grid lines within the wall's depth are scanned when its normal is a grid axis (a piston:
+   !> a few lines of nodes per step), the rank's whole box otherwise.
+   subroutine refresh_moving_walls(walls, grid)
+      type(wall_t), intent(inout) :: walls(:)
+      type(grid_t), intent(in) :: grid
+      integer :: w, lo(3), hi(3), k
+      real(rp) :: a, b
+      do w = 1, size(walls)
+         if (.not. walls(w)%moving) cycle
+         if (all(walls(w)%point == walls(w)%nodes_point) .and. allocated(walls(w)%nodes)) cycle
+         lo = grid%node_lo
+         hi = grid%node_hi
+         k = walls(w)%axis
+         if (k > 0) then
+            ! nodes with -depth <= phi <= tolerance lie between these planes (one line more each side)
+            a = walls(w)%point(k) - walls(w)%depth
+            b = walls(w)%point(k) + walls(w)%depth
+            lo(k) = max(lo(k), floor((a - grid%origin(k)) / grid%h) - 1)
+            hi(k) = min(hi(k), ceiling((b - grid%origin(k)) / grid%h) + 1)
+         end if
+         if (allocated(walls(w)%nodes)) deallocate (walls(w)%nodes)
+         if (allocated(walls(w)%counted)) deallocate (walls(w)%counted)
+         if (allocated(walls(w)%arm)) deallocate (walls(w)%arm)
+         call find_wall_nodes(walls(w), grid, lo, hi)
+         walls(w)%nodes_point = walls(w)%point
+      end do
+   end subroutine refresh_moving_walls
+
+   !> The nodes of lo..hi (global node indices) a planar wall constrains, with its loads' bookkeeping.
+   subroutine find_wall_nodes(wall, grid, lo, hi)
+      type(wall_t), intent(inout) :: wall
+      type(grid_t), intent(in) :: grid
+      integer, intent(in) :: lo(3), hi(3)
+      integer :: dim, n, i, j, l, g(3)
+      integer, allocatable :: found(:)
+      logical, allocatable :: owned(:)
+      real(rp) :: x(3)
+      dim = grid%dim
+      allocate (found(max(0, product(hi - lo + 1))), owned(max(0, product(hi - lo + 1))))
+      n = 0
+      x = 0.0_rp
+      do l = lo(3), hi(3)
+         do j = lo(2), hi(2)
+            do i = lo(1), hi(1)
+               g = [i, j, l]
+               x(1:dim) = grid%origin(1:dim) + g(1:dim) * grid%h
+               if (.not. behind_wall(wall, grid, x(1:dim), on_wall_tolerance * grid%h)) cycle
+               n = n + 1
+               found(n) = grid%local_node(g(1:dim))
+               owned(n) = grid%owns_node(g(1:dim))
+            end do
+         end do
+      end do
+      call keep_nodes(wall, grid, found(1:n), owned(1:n))
+   end subroutine find_wall_nodes
 
    !> The wall kind of a condition keyword ('slip', 'no_slip', 'friction').
    pure integer function condition_kind(condition) result(kind)
@@ -377,7 +516,7 @@ contains
       real(rp), intent(inout), optional :: impulse(:, :)
       real(rp), intent(in), optional :: friction(:)
       integer :: w, i, node, kind
-      real(rp) :: vn, before(dim), n(dim), mu
+      real(rp) :: vn, before(dim), n(dim), mu, vw(dim)
       logical :: recording
       recording = present(mass) .and. present(impulse)
       do w = 1, size(walls)
@@ -391,10 +530,30 @@ contains
                mu = friction(w)
             end if
          end if
+         vw = walls(w)%wall_velocity(1:dim)
          do i = 1, size(walls(w)%nodes)
             node = walls(w)%nodes(i)
             before = velocity(:, node)
             if (walls(w)%shaped) n = walls(w)%node_normal(:, i)
+            if (walls(w)%moving) then
+               ! the same conditions on the velocity relative to the wall's
+               select case (kind)
+               case (wall_kind_no_slip)
+                  velocity(:, node) = vw
+               case (wall_kind_friction)
+                  if (dot_product(before - vw, n) >= 0.0_rp) cycle
+                  velocity(:, node) = vw + unilateral_velocity(before - vw, n, mu)
+               case default
+                  vn = dot_product(before - vw, n)
+                  if (vn >= 0.0_rp) cycle
+                  velocity(:, node) = before - vn * n
+               end select
+               if (recording) then
+                  if (walls(w)%counted(i)) call add_impulse(impulse(:, w), mass(node) * (velocity(:, node) - before), &
+                                                            walls(w)%arm(1:dim, i))
+               end if
+               cycle
+            end if
             select case (kind)
             case (wall_kind_no_slip)
                velocity(:, node) = 0.0_rp
@@ -506,7 +665,15 @@ contains
                if (walls(w)%normal(k) > 0.0_rp .and. lowest(k) - walls(w)%point(k) >= 0.0_rp) cycle
                if (walls(w)%normal(k) < 0.0_rp .and. highest(k) - walls(w)%point(k) <= 0.0_rp) cycle
             end associate
-            call keep_inside_axis_wall(walls(w), grid, particles, corrections, impulse(:, w), skipped)
+            if (walls(w)%moving) then
+               call keep_inside_moving_wall(walls(w), grid, particles, corrections, impulse(:, w), skipped)
+            else
+               call keep_inside_axis_wall(walls(w), grid, particles, corrections, impulse(:, w), skipped)
+            end if
+            cycle
+         end if
+         if (walls(w)%moving) then
+            call keep_inside_moving_wall(walls(w), grid, particles, corrections, impulse(:, w), skipped)
             cycle
          end if
          associate (n => walls(w)%normal(1:d), x0 => walls(w)%point(1:d))
@@ -628,6 +795,43 @@ contains
          end do
       end do
    end subroutine position_bounds
+
+   !> The safeguard of a moving wall (at its place at the step's end): a particle behind it goes back onto
+   !> it and gets at least the wall's normal velocity, v - v_w losing its part into the wall (friction:
+   !> Coulomb's share of the tangential part too).
+   subroutine keep_inside_moving_wall(wall, grid, particles, corrections, impulse, skip)
+      type(wall_t), intent(in) :: wall
+      type(grid_t), intent(in) :: grid
+      type(particle_set_t), intent(inout) :: particles
+      integer, intent(inout) :: corrections
+      real(rp), intent(inout) :: impulse(:)
+      logical, intent(in) :: skip(:)
+      integer :: p, d
+      real(rp) :: distance, vn, before(particles%dim), vw(particles%dim)
+      d = particles%dim
+      vw = wall%wall_velocity(1:d)
+      associate (n => wall%normal(1:d), x0 => wall%point(1:d))
+         do p = 1, particles%count
+            distance = dot_product(particles%x(:, p) - x0, n)
+            if (distance >= 0.0_rp) cycle
+            if (skip(particles%material(p))) cycle
+            if (.not. behind_wall(wall, grid, particles%x(:, p), 0.0_rp)) cycle
+            particles%x(:, p) = particles%x(:, p) - distance * n
+            before = particles%v(:, p)
+            vn = dot_product(before - vw, n)
+            if (vn < 0.0_rp) then
+               if (wall%kind == wall_kind_friction) then
+                  particles%v(:, p) = vw + unilateral_velocity(before - vw, n, wall%friction)
+               else
+                  particles%v(:, p) = before - vn * n
+               end if
+               call add_impulse(impulse, particles%mass(p) * (particles%v(:, p) - before), &
+                                particles%x(:, p) - wall%moment_point(1:d))
+            end if
+            corrections = corrections + 1
+         end do
+      end associate
+   end subroutine keep_inside_moving_wall
 
    !> The safeguard for a wall normal to grid axis k: the same operation without the dot products.
    subroutine keep_inside_axis_wall(wall, grid, particles, corrections, impulse, skip)

@@ -3,6 +3,7 @@ module scene_broadcast
    use mpi_f08, only: MPI_Comm, MPI_Bcast, MPI_Comm_rank, MPI_CHARACTER, MPI_INTEGER, MPI_DOUBLE_PRECISION, &
                       MPI_LOGICAL
    use scene_description, only: scene_t
+   use time_table, only: time_table_t
    implicit none
    private
 
@@ -71,7 +72,8 @@ contains
       if (rank /= root) call resize(bytes, n)
       call MPI_Bcast(bytes, n, MPI_CHARACTER, root, comm)
       call broadcast_body_points(scene, counts(2), comm, root, rank)
-      call broadcast_inlet_tables(scene, counts(4), comm, root, rank)
+      call broadcast_tables(scene%inlet_tables, counts(4), comm, root, rank)
+      call broadcast_tables(scene%wall_tables, counts(3), comm, root, rank)
       if (rank == root) return
 
       at = 1
@@ -138,27 +140,28 @@ contains
       end do
    end subroutine broadcast_body_points
 
-   !> The time tables of the inlets (scene%inlet_tables): per inlet the numbers of columns and rows
-   !> (-1: no table), then path, checksum, column names, times, values and lines.
-   subroutine broadcast_inlet_tables(scene, inlets, comm, root, rank)
-      type(scene_t), intent(inout) :: scene
-      integer, intent(in) :: inlets, root, rank
+   !> Time tables of the inlets or the walls (scene%inlet_tables, scene%wall_tables; none: unallocated):
+   !> per entry the numbers of columns and rows (-1: no table), then path, checksum, column names, times,
+   !> values and lines.
+   subroutine broadcast_tables(tables, entries, comm, root, rank)
+      type(time_table_t), allocatable, intent(inout) :: tables(:)
+      integer, intent(in) :: entries, root, rank
       type(MPI_Comm), intent(in) :: comm
       integer :: i, shape(2)
       logical :: has_tables
-      if (inlets < 0) return
-      has_tables = allocated(scene%inlet_tables)
+      if (entries < 0) return
+      has_tables = allocated(tables)
       call MPI_Bcast(has_tables, 1, MPI_LOGICAL, root, comm)
       if (.not. has_tables) then
-         if (allocated(scene%inlet_tables)) deallocate (scene%inlet_tables)
+         if (allocated(tables)) deallocate (tables)
          return
       end if
       if (rank /= root) then
-         if (allocated(scene%inlet_tables)) deallocate (scene%inlet_tables)
-         allocate (scene%inlet_tables(inlets))
+         if (allocated(tables)) deallocate (tables)
+         allocate (tables(entries))
       end if
-      do i = 1, inlets
-         associate (table => scene%inlet_tables(i))
+      do i = 1, entries
+         associate (table => tables(i))
             shape = -1
             if (rank == root .and. allocated(table%time)) shape = [size(table%values, 1), size(table%time)]
             call MPI_Bcast(shape, 2, MPI_INTEGER, root, comm)
@@ -173,7 +176,7 @@ contains
             call MPI_Bcast(table%line, shape(2), MPI_INTEGER, root, comm)
          end associate
       end do
-   end subroutine broadcast_inlet_tables
+   end subroutine broadcast_tables
 
    !> Allocate `bytes` with `n` elements (assigning to an unallocated array first makes gfortran 12
    !> warn falsely about uninitialised bounds).

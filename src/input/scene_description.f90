@@ -20,6 +20,12 @@ module scene_description
    !> Unilateral with Coulomb friction (`&wall`, `&box_walls`, `&structure` with `friction` = mu).
    character(len=*), parameter, public :: wall_friction = 'friction'
 
+   !> `&wall motion=` keywords: a fixed wall, the piston stroke of a solitary wave (Goring 1978), a
+   !> displacement read from a time table (docs/input.md).
+   character(len=*), parameter, public :: motion_none = 'none'
+   character(len=*), parameter, public :: motion_solitary_wave = 'solitary_wave'
+   character(len=*), parameter, public :: motion_table = 'table'
+
    !> Material model keywords (`&material model=`).
    character(len=*), parameter, public :: model_newtonian_fluid = 'newtonian_fluid'
    character(len=*), parameter, public :: model_linear_elastic = 'linear_elastic'
@@ -95,6 +101,15 @@ module scene_description
       !> point the moment of the wall's load is taken about [m]; huge: not given, resolved to the component
       !> of `point`
       real(rp) :: moment_point(3) = huge(1.0_rp)
+      !> prescribed rigid translation (wall_motion): 'none', 'solitary_wave' or 'table'
+      character(len=name_len) :: motion = motion_none
+      real(rp) :: motion_start = 0.0_rp       !< solitary_wave: the stroke starts [s]
+      real(rp) :: wave_height = 0.0_rp        !< solitary_wave: wave height A [m]
+      real(rp) :: water_depth = 0.0_rp        !< solitary_wave: still-water depth h [m]
+      !> table: CSV of the displacement (t, x, y[, z]); resolved to an absolute path
+      character(len=path_len) :: motion_file = ''
+      !> table: checksum of the numbers read from motion_file (16 hex digits); given: must match the file
+      character(len=16) :: motion_checksum = ''
    end type wall_spec_t
 
    !> `&structure`: a fixed rigid obstacle of any shape and orientation (world frame) whose surface
@@ -226,6 +241,8 @@ module scene_description
       !> per body, the points of its points_file (read by rank 0, broadcast with the scene)
       type(body_points_t), allocatable :: body_points(:)
       type(wall_spec_t), allocatable :: walls(:)      !< `&wall` groups (the `&box_walls` sides are in grid)
+      !> per wall, the table of its motion_file (read by rank 0, broadcast with the scene; empty otherwise)
+      type(time_table_t), allocatable :: wall_tables(:)
       type(structure_spec_t), allocatable :: structures(:)   !< `&structure` groups
       type(inlet_spec_t), allocatable :: inlets(:)
       !> per inlet, the table of its velocity_file (read by rank 0, broadcast with the scene; no rows: none)

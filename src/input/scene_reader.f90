@@ -23,6 +23,7 @@ module scene_reader
    use input_text, only: lower_case, upper_case, int_text, ordinal, group_context, canonical_keyword
    use point_file, only: load_body_points
    use inlet_table, only: load_inlet_tables
+   use wall_motion, only: load_wall_tables
    implicit none
    private
 
@@ -152,6 +153,12 @@ module scene_reader
       variable_info_t('wall', 'friction', 'real', .false.), &
       variable_info_t('wall', 'name', 'string', .false.), &
       variable_info_t('wall', 'moment_point', 'real3', .false.), &
+      variable_info_t('wall', 'motion', 'string', .false.), &
+      variable_info_t('wall', 'motion_start', 'real', .false.), &
+      variable_info_t('wall', 'wave_height', 'real', .false.), &
+      variable_info_t('wall', 'water_depth', 'real', .false.), &
+      variable_info_t('wall', 'motion_file', 'string', .false.), &
+      variable_info_t('wall', 'motion_checksum', 'string', .false.), &
       variable_info_t('inlet', 'name', 'string', .false.), &
       variable_info_t('inlet', 'material', 'string', .true.), &
       variable_info_t('inlet', 'point', 'real3', .true.), &
@@ -234,6 +241,8 @@ contains
          ! the points of `&body points_file` (checked like the scene's values, before any output)
          if (status%ok) call load_body_points(scene, label, status)
          if (status%ok) call load_inlet_tables(scene, label, status)
+         ! the tables of `&wall motion = 'table'` (the whole motion checked against the scene box)
+         if (status%ok) call load_wall_tables(scene, label, status)
          if (status%ok) call resolve_scene(scene)
          ! before any particle is made: a scene too large for the machine is refused, not run out of memory
          if (status%ok) call check_scene_memory(scene, label, ranks, budget, status)
@@ -1149,9 +1158,11 @@ contains
       integer, intent(out) :: ios
       character(len=*), intent(inout) :: message
       character(len=*), intent(in) :: text
-      character(len=text_len) :: condition, name
-      real(rp) :: point(3), normal(3), lower(3), upper(3), moment_point(3), friction
-      namelist /wall/ point, normal, lower, upper, condition, friction, name, moment_point
+      character(len=text_len) :: condition, name, motion, motion_file, motion_checksum
+      real(rp) :: point(3), normal(3), lower(3), upper(3), moment_point(3), friction, motion_start, wave_height, &
+                  water_depth
+      namelist /wall/ point, normal, lower, upper, condition, friction, name, moment_point, motion, motion_start, &
+         wave_height, water_depth, motion_file, motion_checksum
 
       point = spec%point
       normal = spec%normal
@@ -1161,10 +1172,22 @@ contains
       friction = spec%friction
       name = spec%name
       moment_point = spec%moment_point
+      motion = spec%motion
+      motion_file = spec%motion_file
+      motion_checksum = spec%motion_checksum
+      motion_start = spec%motion_start
+      wave_height = spec%wave_height
+      water_depth = spec%water_depth
       read (text, nml=wall, iostat=ios, iomsg=message)
       call take_text('condition', condition, spec%condition, ios, message, fold='lower')
       call take_text('name', name, spec%name, ios, message)
+      call take_text('motion', motion, spec%motion, ios, message, fold='lower')
+      call take_text('motion_file', motion_file, spec%motion_file, ios, message)
+      call take_text('motion_checksum', motion_checksum, spec%motion_checksum, ios, message, fold='lower')
       if (ios /= 0) return
+      spec%motion_start = motion_start
+      spec%wave_height = wave_height
+      spec%water_depth = water_depth
       spec%point = point
       spec%normal = normal
       spec%lower = lower

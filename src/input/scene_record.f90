@@ -346,6 +346,18 @@ contains
             text = quoted(wall%name)
          case ('moment_point')
             text = reals(wall%moment_point)
+         case ('motion')
+            text = quoted(wall%motion)
+         case ('motion_start')
+            text = real_text(wall%motion_start)
+         case ('wave_height')
+            text = real_text(wall%wave_height)
+         case ('water_depth')
+            text = real_text(wall%water_depth)
+         case ('motion_file')
+            text = quoted(wall%motion_file)
+         case ('motion_checksum')
+            text = quoted(wall%motion_checksum)
          case default
             text = ''
          end select

@@ -9,7 +9,7 @@ module scene_validation
    use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
                                 inlet_spec_t, gauge_spec_t, contact_spec_t, structure_spec_t, opening_far_end, wall_none, &
                                 has_velocity_file, &
-                                wall_slip, wall_no_slip, wall_friction, &
+                                wall_slip, wall_no_slip, wall_friction, motion_none, motion_solitary_wave, motion_table, &
                                 model_newtonian_fluid, model_linear_elastic, model_rigid, gauge_pressure, gauge_level, &
                                 gauge_velocity, &
                                 particle_field_names, field_precision_keywords
@@ -19,6 +19,7 @@ module scene_validation
                              max_vertices, no_vertex, shape_box, shape_circle, shape_sphere, shape_cylinder, &
                              shape_polygon, shape_extruded_polygon
    use body_lattice, only: has_points_file, box_corners_given, body_shape, body_bounds, count_particles, particle_spacing
+   use wall_motion, only: wall_motion_t, motion_of_wall
    implicit none
    private
 
@@ -54,6 +55,13 @@ module scene_validation
    character(len=*), parameter, public :: update_scheme_keywords(*) = [character(len=4) :: 'USL', 'MUSL']
    !> Accepted `&run transfer=` keywords (stored lower case).
    character(len=*), parameter, public :: transfer_keywords(*) = [character(len=8) :: 'flip_pic', 'apic']
+   !> Accepted `&wall motion=` keywords (stored lower case).
+   character(len=*), parameter, public :: motion_keywords(*) = [character(len=13) :: motion_none, &
+                                                                motion_solitary_wave, motion_table]
+   !> Largest solitary wave height over depth a wall may make (solitary waves break near A/h = 0.78;
+   !> Goring's first-order stroke is poor beyond about 0.6).
+   real(rp), parameter :: max_wave_ratio = 0.6_rp
+
    !> Accepted `&box_walls` keywords (stored lower case).
    character(len=*), parameter, public :: wall_keywords(*) = [character(len=8) :: wall_none, wall_slip, wall_no_slip, &
                                                               wall_friction]
@@ -129,7 +137,7 @@ contains
       end do
       if (allocated(scene%walls)) then
          do w = 1, size(scene%walls)
-            call validate_wall(scene%walls(w), w, scene%grid%dim, path, status)
+            call validate_wall(scene%walls(w), w, scene, path, status)
             if (.not. status%ok) return
          end do
       end if
@@ -1101,14 +1109,16 @@ contains
       if (len_trim(body%name) > 0) detail = "name '"//trim(body%name)//"', "//detail
    end function body_detail
 
-   subroutine validate_wall(wall, w, dim, path, status)
+   subroutine validate_wall(wall, w, scene, path, status)
       type(wall_spec_t), intent(in) :: wall
-      integer, intent(in) :: w, dim
+      integer, intent(in) :: w
+      type(scene_t), intent(in) :: scene
       character(len=*), intent(in) :: path
       type(status_t), intent(inout) :: status
       character(len=:), allocatable :: where
-      integer :: k
+      integer :: k, dim
 
+      dim = scene%grid%dim
       where = group_context(path, 'wall', w, name_detail(wall%name))
       call check_name(where, 'name', wall%name, status)
       do k = 1, dim
@@ -1140,7 +1150,86 @@ contains
                           ", got '"//trim(wall%condition)//"'")
       end if
       call check_friction(where, wall%condition, wall%friction, status)
+      call validate_wall_motion(wall, where, scene, status)
    end subroutine validate_wall
+
+   !> `&wall motion`: a known keyword; its variables given only with it; the solitary wave's height and
+   !> depth in range (A/h in (0, max_wave_ratio], gravity not zero); the whole motion keeps the wall's
+   !> point in the scene box.
+   subroutine validate_wall_motion(wall, where, scene, status)
+      type(wall_spec_t), intent(in) :: wall
+      character(len=*), intent(in) :: where
+      type(scene_t), intent(in) :: scene
+      type(status_t), intent(inout) :: status
+      type(wall_motion_t) :: motion
+      real(rp) :: g, moved(3), box_lower(3), box_upper(3), tolerance
+      integer :: k, dim
+      if (.not. status%ok) return
+      dim = scene%grid%dim
+      if (all(wall%motion /= motion_keywords)) then
+         call status%fail(where//': variable motion must be one of '//quoted_list(motion_keywords)//", got '"// &
+                          trim(wall%motion)//"'")
+         return
+      end if
+      if (wall%motion /= motion_solitary_wave) then
+         if (wall%wave_height /= 0.0_rp) call refuse('wave_height')
+         if (wall%water_depth /= 0.0_rp) call refuse('water_depth')
+      end if
+      if (wall%motion == motion_none .and. wall%motion_start /= 0.0_rp) call refuse('motion_start')
+      if (wall%motion /= motion_table) then
+         if (len_trim(wall%motion_file) > 0) call refuse('motion_file')
+         if (len_trim(wall%motion_checksum) > 0) call refuse('motion_checksum')
+      else if (len_trim(wall%motion_file) == 0) then
+         call status%fail(where//": variable motion_file is required with motion = '"//motion_table// &
+                          "' (a CSV of t, x, y[, z]: the wall's displacement)")
+      end if
+      if (wall%motion == motion_table .and. wall%motion_start /= 0.0_rp) then
+         call status%fail(where//": variable motion_start belongs to motion = '"//motion_solitary_wave// &
+                          "' (a table gives its own times)")
+      end if
+      ! a table is checked against the scene box when it is read (load_wall_tables)
+      if (.not. status%ok .or. wall%motion == motion_none .or. wall%motion == motion_table) return
+      call check_real(where, 'motion_start', wall%motion_start, status, at_least=0.0_rp)
+      if (.not. status%ok) return
+      if (wall%motion == motion_solitary_wave) then
+         call check_real(where, 'water_depth', wall%water_depth, status, greater_than=0.0_rp)
+         call check_real(where, 'wave_height', wall%wave_height, status, greater_than=0.0_rp, &
+                         at_most=max_wave_ratio * wall%water_depth)
+         g = norm2(scene%gravity(1:dim))
+         if (status%ok .and. g <= 0.0_rp) call status%fail(where//": variable motion = '"//motion_solitary_wave// &
+                                                           "' needs gravity (&gravity acceleration is zero)")
+         if (.not. status%ok) return
+         motion = motion_of_wall(wall, scene%gravity, dim)
+         ! the stroke is monotonic along the normal: its end is the farthest point
+         moved = wall%point + motion%stroke() * motion%direction
+      end if
+      box_lower = scene%grid%origin
+      box_upper = scene%grid%origin + scene%grid%extent
+      tolerance = 1.0e-9_rp * scene%grid%cell_size
+      do k = 1, dim
+         if (moved(k) < box_lower(k) - tolerance .or. moved(k) > box_upper(k) + tolerance) then
+            call status%fail(where//": variable motion = '"//trim(wall%motion)//"' drives the wall out of the scene "// &
+                             'box of &grid: its point('//int_text(k)//') reaches '//real_text(moved(k))// &
+                             ', the box is '//real_text(box_lower(k))//' .. '//real_text(box_upper(k)))
+            return
+         end if
+      end do
+
+   contains
+
+      subroutine refuse(variable)
+         character(len=*), intent(in) :: variable
+         character(len=:), allocatable :: owner
+         if (.not. status%ok) return
+         ! motion_start belongs to every motion, the others to the solitary wave
+         owner = "motion = '"//motion_solitary_wave//"'"
+         if (variable == 'motion_start') owner = 'a motion'
+         if (variable(1:min(7, len(variable))) == 'motion_' .and. variable /= 'motion_start') &
+            owner = "motion = '"//motion_table//"'"
+         call status%fail(where//': variable '//variable//' belongs to '//owner//", which is not given (motion = '"// &
+                          trim(wall%motion)//"')")
+      end subroutine refuse
+   end subroutine validate_wall_motion
 
    !> mu >= 0, and given only with condition 'friction' (elsewhere it would be silently unused).
    subroutine check_friction(where, condition, friction, status)

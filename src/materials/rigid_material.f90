@@ -1,4 +1,4 @@
-!> A rigid solid (`&material model = 'rigid'`, docs/theory.md section 3.6): its particles move as one rigid
+!> A rigid solid (`&material model = 'rigid'`, docs/theory.md section 3.7): its particles move as one rigid
 !> body of each `&body` (src/solver/rigid_bodies.f90), so the material itself has no stress and no waves.
 !> Its particles keep sbar = 0 (they add no internal force to the grid: the fluid's and the walls' forces
 !> on the body reach it through the nodal velocity increments) and their density (their volume is

@@ -37,7 +37,8 @@ module mpm_solver
    use stabilizer_factory, only: build_stabilizers
    use volume_correction, only: volume_corrector_t, max_shift_in_cells
    use boundary_walls, only: wall_t, build_walls, build_structures, set_wall_activity, apply_wall_constraints, &
-                             keep_particles_inside, first_particle_inside, box_side_walls, wall_distance
+                             keep_particles_inside, first_particle_inside, box_side_walls, wall_distance, move_walls, &
+                             place_moving_walls, moving_wall_speed
    use fluid_inflow, only: inlet_t, build_inlets
    use wall_loads, only: wall_loads_t
    use fluid_gauges, only: fluid_gauges_t
@@ -217,7 +218,12 @@ contains
       type(wall_spec_t), allocatable :: no_walls(:)
       integer :: entries
       if (allocated(self%scene%walls)) then
-         call build_walls(self%scene%walls, self%scene%grid, self%grid, self%walls)
+         if (allocated(self%scene%wall_tables)) then
+            call build_walls(self%scene%walls, self%scene%grid, self%grid, self%walls, self%scene%gravity, self%time, &
+                             self%scene%wall_tables)
+         else
+            call build_walls(self%scene%walls, self%scene%grid, self%grid, self%walls, self%scene%gravity, self%time)
+         end if
       else
          allocate (no_walls(0))
          call build_walls(no_walls, self%scene%grid, self%grid, self%walls)
@@ -409,6 +415,8 @@ contains
       do i = 1, size(self%inlets)
          call self%inlets(i)%feed(self%walls, self%grid, self%time + dt)
       end do
+      ! moving walls: placed at t_n (node lists rebuilt), their velocity the mean over the step
+      call move_walls(self%walls, self%grid, self%time, self%time + dt)
       call self%loads%begin_step(size(self%walls))
       if (self%volume%shifting) then
          call self%timers%switch_to(phase_volume_correction)
@@ -484,6 +492,8 @@ contains
       end if
 
       call self%timers%switch_to(phase_walls)
+      ! the safeguard against the moving walls where they are at the step's end
+      call place_moving_walls(self%walls, self%grid, self%time + dt)
       if (self%contact%active) then
          call keep_particles_inside(self%walls, self%grid, self%particles, self%wall_corrections, self%loads%step_impulse, &
                                     self%contact%particle_field, self%contact%wall_friction(size(self%walls)), &
@@ -724,7 +734,7 @@ contains
       speeds = -speeds
       call MPI_Allreduce(MPI_IN_PLACE, speeds, size(speeds), MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
       call count_collective(comm_time_step, size(speeds), real_bytes)
-      call time_step_of_speeds(self, -speeds, dt, speed)
+      call time_step_of_speeds(self, -speeds, wall_speed_ahead(self), dt, speed)
    end function solver_stable_time_step
 
    !> This rank's part of the step's bound, per material m: speeds(2 m - 1) the wave speed at the lowest
@@ -767,15 +777,22 @@ contains
    !> blowing-up state may have no valid one). An inlet that is not closed yet counts as a particle of its
    !> fluid at rho0 moving at v0 (a hydrograph: its largest speed until it closes): the step must resolve
    !> the fluid it is about to create (and an empty tank must not take a huge step).
-   subroutine time_step_of_speeds(self, speeds, dt, speed)
+   subroutine time_step_of_speeds(self, speeds, wall_speed, dt, speed)
       type(solver_t), intent(in) :: self
-      real(rp), intent(in) :: speeds(:)
+      real(rp), intent(in) :: speeds(:), wall_speed
       real(rp), intent(out) :: dt, speed
       integer :: m, i
       speed = 0.0_rp
       do m = 1, size(self%materials)
          speed = max(speed, speeds(2 * m - 1) + speeds(2 * m))
       end do
+      ! a moving wall counts as a particle of every material moving at its speed (it drives the material
+      ! next to it at that speed); none: speed unchanged, bit for bit
+      if (wall_speed > 0.0_rp) then
+         do m = 1, size(self%materials)
+            speed = max(speed, speeds(2 * m - 1) + wall_speed)
+         end do
+      end if
       if (self%run%fixed_dt > 0.0_rp) then
          dt = self%run%fixed_dt
          do i = 1, size(self%inlets)
@@ -804,7 +821,7 @@ contains
    subroutine follow_particles(self)
       type(solver_t), intent(inout) :: self
       real(rp), allocatable :: values(:)
-      real(rp) :: speed
+      real(rp) :: speed, wall_speed
       integer :: dim, need_lo(3), need_hi(3), box_lo(3), box_hi(3), target_lo(3), target_hi(3), guard, margin, n, flags
       integer :: cuts(0:self%domain%nranks, 3)
       integer(i8) :: largest
@@ -835,7 +852,8 @@ contains
       call MPI_Allreduce(MPI_IN_PLACE, values, size(values), MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
       call count_collective(comm_time_step, size(values), real_bytes)
       if (flags > 0) self%loop_flags = nint(-values(n + 1:))
-      call time_step_of_speeds(self, -values(7:n), self%dt, speed)
+      wall_speed = wall_speed_ahead(self)
+      call time_step_of_speeds(self, -values(7:n), wall_speed, self%dt, speed)
 
       ! a state that is no longer finite is the health check's business, not the layout's
       if (.not. all(ieee_is_finite(values(1:n)))) return
@@ -856,6 +874,13 @@ contains
       call self%set_layout(cuts, status)
       self%relayouts = self%relayouts + 1
    end subroutine follow_particles
+
+   !> The largest speed of the moving walls over the next two steps (two of the last step's length: the
+   !> next one is not known yet), for the time step and the active region's guard. 0 without moving walls.
+   real(rp) function wall_speed_ahead(self) result(speed)
+      type(solver_t), intent(in) :: self
+      speed = moving_wall_speed(self%walls, self%time, self%time + 2.0_rp * self%dt)
+   end function wall_speed_ahead
 
    !> CFL rho0 h^2 / (2 dim mu) over the viscous fluids present.
    real(rp) function viscous_time_step(self) result(dt)

@@ -1,4 +1,4 @@
-!> Rigid bodies: the bodies of a `&material model = 'rigid'` (docs/theory.md section 3.6, issue 18).
+!> Rigid bodies: the bodies of a `&material model = 'rigid'` (docs/theory.md section 3.7, issue 18).
 !>
 !> Each such `&body` moves as one rigid body: centre of mass c, velocity V, angular momentum L about c and
 !> rotation R from its reference placement (where seed_bodies put its particles: body_motion's reference
@@ -54,8 +54,8 @@ module rigid_bodies
    real(rp), parameter :: impulse_tolerance = 1.0e-12_rp
    !> Fraction of a closed gap (overlap) opened per step: a full one would throw the body off.
    real(rp), parameter :: overlap_recovery = 0.2_rp
-   !> Columns of a contact point record: id, wall, body, r (3), n (3), gap, mu.
-   integer, parameter :: record_width = 11
+   !> Columns of a contact point record: id, wall, body, r (3), n (3), gap, mu, the wall's velocity (3).
+   integer, parameter :: record_width = 14
 
    type :: rigid_body_t
       integer :: tracked = 0                     !< its index among body_motion's solid bodies
@@ -404,7 +404,7 @@ contains
             end if
             found = found + 1
             records(:, found) = [real(particles%id(p), rp), real(w, rp), real(b, rp), r, normal, &
-                                 wall_distance(walls(w), grid, x) - radius, mu]
+                                 wall_distance(walls(w), grid, x) - radius, mu, walls(w)%wall_velocity]
          end do
       end subroutine find_contacts
 
@@ -573,7 +573,8 @@ contains
    end function key_order
 
    !> Projected Gauss-Seidel over the contact points of body b (in `order`): accumulated normal impulses
-   !> lambda_n >= 0 that keep u_n >= -g / dt, and tangential impulses within mu lambda_n (mu < 0: no bound).
+   !> lambda_n >= 0 that keep u_n >= -g / dt, and tangential impulses within mu lambda_n (mu < 0: no bound),
+   !> u the velocity relative to the wall's (a moving wall's mean velocity over the step).
    !> The body's particle at r (from c) moves at u = V + w x r + dv + dw x (r - offset) after the step; an
    !> impulse j there changes the cluster's (mass, inverse inertia about c_S = c + offset) dv and dw.
    !> applied(:, c) gets the impulse of point c.
@@ -584,7 +585,7 @@ contains
       real(rp), intent(in) :: records(:, :), dt, h, mass, offset(3), inverse(3, 3)
       real(rp), intent(inout) :: dv(3), dw(3), applied(:, :)
       real(rp) :: r(3), rs(3), n(3), u(3), un, target, change, largest, normal_impulse, tangential(3), t(3)
-      real(rp) :: speed, limit, tolerance, new_tangential(3), dj(3)
+      real(rp) :: speed, limit, tolerance, new_tangential(3), dj(3), wall_velocity(3)
       integer :: k, c, iteration
       if (size(records, 2) == 0) return
       if (.not. any(nint(records(3, :)) == b)) return
@@ -597,7 +598,8 @@ contains
             r = records(4:6, c)
             rs = r - offset
             n = records(7:9, c)
-            un = dot_product(velocity_at(), n)
+            wall_velocity = records(12:14, c)
+            un = dot_product(velocity_at() - wall_velocity, n)
             if (records(10, c) >= 0.0_rp) then
                target = -records(10, c) / dt
             else
@@ -611,7 +613,7 @@ contains
             ! friction: stop the sliding at the point, within mu times the normal impulse
             normal_impulse = normal_impulse + change
             tangential = applied(:, c) - normal_impulse * n
-            u = velocity_at()
+            u = velocity_at() - wall_velocity
             u = u - dot_product(u, n) * n
             speed = norm2(u)
             if (speed == 0.0_rp) cycle

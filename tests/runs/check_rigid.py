@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Rigid bodies (`&material model = 'rigid'`, issue 18, item 3; docs/theory.md section 3.6), in whole runs:
+"""Rigid bodies (`&material model = 'rigid'`, issue 18, item 3; docs/theory.md section 3.7), in whole runs:
 
   1. a rigid box dropped on the floor (2-D) with a fixed step: before it lands its centroid and velocity
      follow the step's exact sequence v_n = -g n dt, y_n = y_0 - g dt^2 n (n + 1) / 2 to round-off (and
