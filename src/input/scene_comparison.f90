@@ -11,6 +11,8 @@ module scene_comparison
    use error_status, only: status_t
    use namelist_scan, only: namelist_file_t, namelist_group_t, scan_namelist_text
    use scene_reader, only: known_groups, repeated_groups
+   use scene_description, only: scene_t
+   use scene_record, only: scene_namelist_text
    use input_text, only: lower_case, int_text
    implicit none
    private
@@ -55,18 +57,21 @@ module scene_comparison
 contains
 
    !> The differences from scene text `old_text` (named `old_label` in messages) to `new_text`, in the
-   !> order of the groups and of the variables of `old_text`. Fails only if a text cannot be scanned.
+   !> order of the groups and of the variables of `old_text`. A variable `old_text` lacks that `new_text`
+   !> gives its default value is no change: a checkpoint written before the variable existed had it at
+   !> that default. Fails only if a text cannot be scanned.
    subroutine compare_scene_texts(old_text, old_label, new_text, new_label, changes, status)
       character(len=*), intent(in) :: old_text, old_label, new_text, new_label
       type(scene_change_t), allocatable, intent(out) :: changes(:)
       type(status_t), intent(inout) :: status
-      type(namelist_file_t) :: old_file, new_file
+      type(namelist_file_t) :: old_file, new_file, defaults
       character(len=:), allocatable :: group, label
       integer :: g, k, n_old, n_new
 
       allocate (changes(0))
       call scan_namelist_text(old_text, old_label, known_groups, old_file, status)
       call scan_namelist_text(new_text, new_label, known_groups, new_file, status)
+      call scan_namelist_text(default_text(), 'the defaults', known_groups, defaults, status)
       if (.not. status%ok) return
       do g = 1, size(known_groups)
          group = trim(known_groups(g))
@@ -77,7 +82,7 @@ contains
             label = group
             if (any(repeated_groups == group)) label = group//'('//int_text(k)//')'
             call compare_groups(old_file%groups(old_file%find(group, k)), new_file%groups(new_file%find(group, k)), &
-                                label, changes)
+                                defaults%groups(defaults%find(group, 1)), label, changes)
          end do
       end do
    end subroutine compare_scene_texts
@@ -119,12 +124,12 @@ contains
 
    !> The variables of two occurrences of a group, matched by designator (the last one wins, as in a
    !> namelist read).
-   subroutine compare_groups(old_group, new_group, label, changes)
-      type(namelist_group_t), intent(in) :: old_group, new_group
+   subroutine compare_groups(old_group, new_group, default_group, label, changes)
+      type(namelist_group_t), intent(in) :: old_group, new_group, default_group
       character(len=*), intent(in) :: label
       type(scene_change_t), allocatable, intent(inout) :: changes(:)
       character(len=*), parameter :: absent = '(not given)'
-      integer :: i, j
+      integer :: i, j, d
       do i = 1, size(old_group%items)
          if (last_item(old_group, key(old_group%items(i)%designator)) /= i) cycle
          j = last_item(new_group, key(old_group%items(i)%designator))
@@ -137,10 +142,23 @@ contains
       end do
       do j = 1, size(new_group%items)
          if (last_item(new_group, key(new_group%items(j)%designator)) /= j) cycle
-         if (last_item(old_group, key(new_group%items(j)%designator)) == 0) &
-            call add_change(changes, item_label(label, new_group%items(j)%designator), absent, new_group%items(j)%value)
+         if (last_item(old_group, key(new_group%items(j)%designator)) /= 0) cycle
+         d = last_item(default_group, key(new_group%items(j)%designator))
+         if (d > 0) then
+            if (same_values(default_group%items(d)%value, new_group%items(j)%value)) cycle
+         end if
+         call add_change(changes, item_label(label, new_group%items(j)%designator), absent, new_group%items(j)%value)
       end do
    end subroutine compare_groups
+
+   !> The scene record of the defaults: a scene of default values with one entry of every group.
+   function default_text() result(text)
+      character(len=:), allocatable :: text
+      type(scene_t) :: defaults
+      allocate (defaults%materials(1), defaults%bodies(1), defaults%walls(1), defaults%structures(1), &
+                defaults%inlets(1), defaults%gauges(1), defaults%contacts(1))
+      text = scene_namelist_text(defaults)
+   end function default_text
 
    !> Index of the last item of `group` whose designator has `wanted` as key; 0 if there is none.
    pure integer function last_item(group, wanted) result(found)

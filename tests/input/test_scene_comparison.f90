@@ -9,7 +9,8 @@ module test_scene_comparison
    private
 
    public :: test_same_scene_in_other_words_is_unchanged, test_changed_physics_is_named, &
-             test_run_settings_are_allowed, test_added_group_and_variable_are_named
+             test_run_settings_are_allowed, test_added_group_and_variable_are_named, &
+             test_new_variable_at_its_default_is_unchanged
 
    character(len=*), parameter :: nl = new_line('a')
 
@@ -117,5 +118,20 @@ contains
       call assertEqual('material(1)%viscosity: (not given) -> 1.0e-3; body groups: 1 -> 2', &
                        describe_changes(changes, .false.), 'the description')
    end subroutine test_added_group_and_variable_are_named
+
+   !> A checkpoint written before a variable existed lacks it: the new scene giving its default is no
+   !> change (a restart of an older checkpoint is not refused), another value is.
+   subroutine test_new_variable_at_its_default_is_unchanged()
+      type(scene_change_t), allocatable :: changes(:)
+      character(len=:), allocatable :: changed
+      changed = edited(edited(original, 'density = 1000.0,', 'density = 1000.0, viscosity = 0.0,'), &
+                       'upper = 1.0, 0.5 /', 'upper = 1.0, 0.5, angular_velocity = 3*0.0 /')
+      call compare(original, changed, changes)
+      call assertEqual(0, size(changes), 'defaults are no change: '//describe_changes(changes, .false.))
+      changed = edited(original, 'upper = 1.0, 0.5 /', 'upper = 1.0, 0.5, angular_velocity = 0.0, 0.0, 1.0 /')
+      call compare(original, changed, changes)
+      call assertEqual('body(1)%angular_velocity: (not given) -> 0.0, 0.0, 1.0', describe_changes(changes, .false.), &
+                       'another value is')
+   end subroutine test_new_variable_at_its_default_is_unchanged
 
 end module test_scene_comparison
