@@ -507,18 +507,21 @@ contains
    !> listed after the scene's walls, wins. With `mass` (nodal masses) and `impulse`, impulse(:, w) gains
    !> the momentum wall w gives the counted nodes, m_i (v_i^c - v_i^*), and its moment (algorithms.md
    !> section 9.1). `friction` (per wall), where >= 0, makes wall w act as a friction wall with that mu
-   !> instead of its own condition: a body field against a structure of its &contact (body_contact).
-   pure subroutine apply_wall_constraints(walls, dim, velocity, mass, impulse, friction)
+   !> instead of its own condition: a body field against a structure of its &contact (body_contact). Nodes
+   !> with `skip(node)` are left alone (a rigid body's nodes: it meets the walls as a body, rigid_bodies).
+   pure subroutine apply_wall_constraints(walls, dim, velocity, mass, impulse, friction, skip)
       type(wall_t), intent(in) :: walls(:)
       integer, intent(in) :: dim
       real(rp), intent(inout) :: velocity(:, :)
       real(rp), intent(in), optional :: mass(:)
       real(rp), intent(inout), optional :: impulse(:, :)
       real(rp), intent(in), optional :: friction(:)
+      logical, intent(in), optional :: skip(:)
       integer :: w, i, node, kind
       real(rp) :: vn, before(dim), n(dim), mu, vw(dim)
-      logical :: recording
+      logical :: recording, masked
       recording = present(mass) .and. present(impulse)
+      masked = present(skip)
       do w = 1, size(walls)
          if (.not. walls(w)%active) cycle
          if (.not. walls(w)%shaped) n = walls(w)%normal(1:dim)
@@ -533,6 +536,9 @@ contains
          vw = walls(w)%wall_velocity(1:dim)
          do i = 1, size(walls(w)%nodes)
             node = walls(w)%nodes(i)
+            if (masked) then
+               if (skip(node)) cycle
+            end if
             before = velocity(:, node)
             if (walls(w)%shaped) n = walls(w)%node_normal(:, i)
             if (walls(w)%moving) then

@@ -445,7 +445,6 @@ contains
       call sum_shared_nodes(self%domain, self%grid, self%grid%accumulated)
       call self%timers%switch_to(phase_grid_update)
       call update_nodes(self, dt)
-      if (self%rigid%active) call solve_rigid_bodies(self, dt)
 
       call self%timers%switch_to(phase_stabilization)
       do m = 1, size(self%schemes)
@@ -556,12 +555,14 @@ contains
       real(rp), intent(in) :: dt
       integer :: i, dim, mom, frc
       real(rp) :: m
+      real(rp), allocatable :: before_walls(:, :)
       dim = self%grid%dim
       if (self%contact%active) then
          call self%contact%nodal_velocities(self%grid, dt, self%mass_tolerance)
          call self%timers%switch_to(phase_walls)
          call self%contact%apply_walls(self%walls, self%grid, self%loads%step_impulse, self%loads%field_impulse)
          call self%timers%switch_to(phase_grid_update)
+         if (self%rigid%active) call solve_rigid_bodies(self, dt)
          return
       end if
       mom = self%grid%row_momentum
@@ -577,12 +578,25 @@ contains
                v(:, i) = 0.0_rp
             end if
          end do
-         call self%timers%switch_to(phase_walls)
-         ! the walls' impulse on the nodes is the load on them (algorithms.md section 9.1); the MUSL re-map
-         ! below applies the walls again to velocities only, which moves no momentum
-         call apply_wall_constraints(self%walls, dim, v, acc(row_mass, :), self%loads%step_impulse)
-         call self%timers%switch_to(phase_grid_update)
-         dv = v - dv
+         if (self%rigid%active) then
+            ! rigid bodies first, on the increments before the walls: a body meets the walls as a body
+            ! (rigid_bodies), and the walls then hold the other nodes only
+            dv = v - dv
+            call solve_rigid_bodies(self, dt)
+            before_walls = v
+            call self%timers%switch_to(phase_walls)
+            call apply_wall_constraints(self%walls, dim, v, acc(row_mass, :), self%loads%step_impulse, &
+                                        skip=self%rigid%held)
+            call self%timers%switch_to(phase_grid_update)
+            dv = dv + (v - before_walls)
+         else
+            call self%timers%switch_to(phase_walls)
+            ! the walls' impulse on the nodes is the load on them (algorithms.md section 9.1); the MUSL re-map
+            ! below applies the walls again to velocities only, which moves no momentum
+            call apply_wall_constraints(self%walls, dim, v, acc(row_mass, :), self%loads%step_impulse)
+            call self%timers%switch_to(phase_grid_update)
+            dv = v - dv
+         end if
       end associate
    end subroutine update_nodes
 

@@ -19,8 +19,9 @@
 !>
 !> Walls and structures [R]: a nodal constraint stops only the nodes it holds, and a rigid body averages
 !> over all its nodes, so a body resting on the floor would sink at g dt (1/phi - 1), phi its mass share on
-!> the floor's nodes. The walls therefore also act on the body itself: each of its particles within a cell
-!> of a wall is a contact point with gap g = phi_w(x_p) - r_p (r_p half its spacing: the particle's
+!> the floor's nodes, and one coming down would creep over its last cell. The walls therefore act on the
+!> body itself, and their nodal constraints (applied after the projection) leave its nodes alone: each of
+!> its particles within a cell of a wall is a contact point with gap g = phi_w(x_p) - r_p (r_p half its spacing: the particle's
 !> surface), whose normal velocity may close the gap within the step but not pass it, u_n >= -g / dt
 !> ("speculative contact"; a gap already closed, g < 0, opens at 0.2 |g| / dt), with Coulomb friction mu
 !> (slip 0, no_slip unbounded, friction the wall's mu). Its impulses act on the cluster S and follow from
@@ -81,6 +82,8 @@ module rigid_bodies
       logical, allocatable :: rigid_material(:)  !< (material) its bodies are rigid
       integer :: contact_points = 0              !< contact points of the last step (all ranks)
       integer :: iterations = 0                  !< contact solver iterations of the last step
+      !> (node) the node belongs to a body's cluster this step: the walls' nodal constraints leave it alone
+      logical, allocatable :: held(:)
    contains
       procedure :: init => rigid_init
       procedure :: solve => rigid_solve
@@ -210,8 +213,9 @@ contains
       end do
    end subroutine measure_bodies
 
-   !> Step 2 of the rigid bodies, after the nodal update and the walls' nodal constraints (grid%velocity
-   !> v^{n+1}, grid%velocity_increment dv), before G2P. Each body's nodes (those its particles touch; a node
+   !> Step 2 of the rigid bodies, after the nodal update (grid%velocity v^{n+1}, grid%velocity_increment dv)
+   !> and before the walls' nodal constraints, which then leave the clusters' nodes alone (`held`); with
+   !> &contact after the fields' walls (a body there still feels the walls' nodal constraints). Before G2P. Each body's nodes (those its particles touch; a node
    !> two bodies touch goes with the one of the larger mass there) form its cluster S, body and fluid mass
    !> together: the rigid limit of the single-field coupling, in which a stiff body's stress makes all the
    !> nodes of its particles move rigidly. The increments of S are projected on a rigid motion, which keeps
@@ -289,6 +293,7 @@ contains
       do i = 1, grid%node_count
          if (any(share(:, i) > 0.0_rp)) owner(i) = maxloc(share(:, i), 1)
       end do
+      self%held = owner > 0
 
       ! each cluster's owned nodes (global index, body, mass, dv), gathered and summed in the order of the
       ! global index on every rank: the same sums, bit for bit, on any number of ranks
