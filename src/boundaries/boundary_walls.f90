@@ -381,10 +381,7 @@ contains
       integer, intent(in), optional :: load
       real(rp), intent(in), optional :: moment_point(3)
       type(wall_t) :: wall
-      integer :: dim, n, i, j, l, g(3)
-      integer, allocatable :: found(:)
-      logical, allocatable :: owned(:)
-      real(rp) :: x(3)
+      integer :: dim
 
       dim = grid%dim
       wall%point = 0.0_rp
@@ -407,22 +404,7 @@ contains
       ! the axis fast path of the safeguard needs a normal with exactly one non-zero component
       if (count(abs(wall%normal(1:dim)) > 0.0_rp) == 1) wall%axis = maxloc(abs(wall%normal(1:dim)), 1)
 
-      allocate (found(grid%node_count), owned(grid%node_count))
-      n = 0
-      x = 0.0_rp
-      do l = grid%node_lo(3), grid%node_hi(3)
-         do j = grid%node_lo(2), grid%node_hi(2)
-            do i = grid%node_lo(1), grid%node_hi(1)
-               g = [i, j, l]
-               x(1:dim) = grid%origin(1:dim) + g(1:dim) * grid%h
-               if (.not. behind_wall(wall, grid, x(1:dim), on_wall_tolerance * grid%h)) cycle
-               n = n + 1
-               found(n) = grid%local_node(g(1:dim))
-               owned(n) = grid%owns_node(g(1:dim))
-            end do
-         end do
-      end do
-      call keep_nodes(wall, grid, found(1:n), owned(1:n))
+      call find_wall_nodes(wall, grid, grid%node_lo, grid%node_hi)
    end function make_wall
 
    !> The wall's local nodes `nodes`, which of them this rank counts in the loads (`owned`), and each
