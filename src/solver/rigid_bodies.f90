@@ -80,8 +80,6 @@ module rigid_bodies
       integer :: dim = 2
       type(rigid_body_t), allocatable :: bodies(:)
       logical, allocatable :: rigid_material(:)  !< (material) its bodies are rigid
-      integer :: contact_points = 0              !< contact points of the last step (all ranks)
-      integer :: iterations = 0                  !< contact solver iterations of the last step
       !> (node) the node belongs to a body's cluster this step: the walls' nodal constraints leave it alone
       logical, allocatable :: held(:)
    contains
@@ -215,8 +213,9 @@ contains
 
    !> Step 2 of the rigid bodies, after the nodal update (grid%velocity v^{n+1}, grid%velocity_increment dv)
    !> and before the walls' nodal constraints, which then leave the clusters' nodes alone (`held`); with
-   !> &contact after the fields' walls (a body there still feels the walls' nodal constraints). Before G2P. Each body's nodes (those its particles touch; a node
-   !> two bodies touch goes with the one of the larger mass there) form its cluster S, body and fluid mass
+   !> &contact after the fields' walls (a body there still feels the walls' nodal constraints). Before G2P.
+   !> Each body's nodes (those its particles touch; a node two bodies touch goes with the one of the larger
+   !> mass there) form its cluster S, body and fluid mass
    !> together: the rigid limit of the single-field coupling, in which a stiff body's stress makes all the
    !> nodes of its particles move rigidly. The increments of S are projected on a rigid motion, which keeps
    !> their momentum and angular momentum [R]:
@@ -343,14 +342,12 @@ contains
       end do
       call gather_columns(records(:, 1:found), domain%comm, comm_rigid, all_records)
       total = size(all_records, 2)
-      self%contact_points = total
       order = record_order(all_records)
       allocate (applied(3, total), motion(9, size(self%bodies)))
       applied = 0.0_rp
 
-      self%iterations = 0
       do b = 1, size(self%bodies)
-         call project_cluster(self, self%bodies(b), b, sums(:, b), all_records, order, dt, grid%h, applied, &
+         call project_cluster(self%dim, self%bodies(b), b, sums(:, b), all_records, order, dt, grid%h, applied, &
                               motion(:, b))
       end do
       ! the clusters' nodes take their rigid increments
@@ -462,8 +459,8 @@ contains
    !> One body's cluster (its sums over S, about its centre c): the rigid projection of the increments, the
    !> walls' contact, and the body's new velocity, angular momentum and step rotation. motion = (dV, dw,
    !> c_S), the cluster's rigid increment (all 0 for a body on no node).
-   subroutine project_cluster(self, body, b, s, records, order, dt, h, applied, motion)
-      type(rigid_set_t), intent(inout) :: self
+   subroutine project_cluster(dim, body, b, s, records, order, dt, h, applied, motion)
+      integer, intent(in) :: dim
       type(rigid_body_t), intent(inout) :: body
       integer, intent(in) :: b, order(:)
       real(rp), intent(in) :: s(:), records(:, :), dt, h
@@ -472,7 +469,7 @@ contains
       real(rp) :: mass, offset(3), dv(3), dw(3), spread(3, 3), inertia(3, 3), inverse(3, 3), momentum(3)
       integer :: j
       motion = 0.0_rp
-      body%spin = matmul(inverse_inertia(body, body%rotation, self%dim), body%angular_momentum)
+      body%spin = matmul(inverse_inertia(body, body%rotation, dim), body%angular_momentum)
       mass = s(1)
       if (mass > 0.0_rp .and. body%mass > 0.0_rp) then
          offset = s(2:4) / mass                              ! c_S - c
@@ -486,25 +483,25 @@ contains
          do j = 1, 3
             inertia(j, j) = inertia(j, j) + (spread(1, 1) + spread(2, 2) + spread(3, 3))
          end do
-         if (self%dim == 2) then
+         if (dim == 2) then
             inverse = 0.0_rp
             if (inertia(3, 3) > 0.0_rp) inverse(3, 3) = 1.0_rp / inertia(3, 3)
          else
             inverse = inverse_3x3(inertia)
          end if
          dw = matmul(inverse, momentum)
-         call resolve_contacts(self, body, b, records, order, dt, h, mass, offset, inverse, dv, dw, applied)
+         call resolve_contacts(body, b, records, order, dt, h, mass, offset, inverse, dv, dw, applied)
          motion(1:3) = dv
          motion(4:6) = dw
          motion(7:9) = body%centre + offset
          body%velocity = body%velocity + dv - cross(dw, offset)
-         body%angular_momentum = body%angular_momentum + matmul(inertia_of(body, body%rotation, self%dim), dw)
-         if (self%dim == 2) body%angular_momentum(1:2) = 0.0_rp
-         body%spin = matmul(inverse_inertia(body, body%rotation, self%dim), body%angular_momentum)
+         body%angular_momentum = body%angular_momentum + matmul(inertia_of(body, body%rotation, dim), dw)
+         if (dim == 2) body%angular_momentum(1:2) = 0.0_rp
+         body%spin = matmul(inverse_inertia(body, body%rotation, dim), body%angular_momentum)
       end if
       body%next_centre = body%centre + dt * body%velocity
       body%next_rotation = matmul(rotation_of(dt * body%spin), body%rotation)
-      body%next_spin = matmul(inverse_inertia(body, body%next_rotation, self%dim), body%angular_momentum)
+      body%next_spin = matmul(inverse_inertia(body, body%next_rotation, dim), body%angular_momentum)
    end subroutine project_cluster
 
    !> Every rank's columns `mine` (rows, n) on every rank, in rank order, counted under `category`. Collective.
@@ -583,8 +580,7 @@ contains
    !> The body's particle at r (from c) moves at u = V + w x r + dv + dw x (r - offset) after the step; an
    !> impulse j there changes the cluster's (mass, inverse inertia about c_S = c + offset) dv and dw.
    !> applied(:, c) gets the impulse of point c.
-   subroutine resolve_contacts(self, body, b, records, order, dt, h, mass, offset, inverse, dv, dw, applied)
-      type(rigid_set_t), intent(inout) :: self
+   subroutine resolve_contacts(body, b, records, order, dt, h, mass, offset, inverse, dv, dw, applied)
       type(rigid_body_t), intent(in) :: body
       integer, intent(in) :: b, order(:)
       real(rp), intent(in) :: records(:, :), dt, h, mass, offset(3), inverse(3, 3)
@@ -632,7 +628,6 @@ contains
             call apply(dj, c)
             largest = max(largest, norm2(dj))
          end do
-         self%iterations = max(self%iterations, iteration)
          if (largest <= tolerance) exit
       end do
 
