@@ -354,7 +354,8 @@ contains
       do i = 1, grid%node_count
          b = owner(i)
          if (b == 0) cycle
-         if (motion(1, b) == 0.0_rp) cycle
+         ! a body on no node (all its particles gone) has no cluster to move
+         if (sums(1, b) <= 0.0_rp .or. self%bodies(b)%mass <= 0.0_rp) cycle
          x = 0.0_rp
          x(1:d) = grid%origin(1:d) + grid%node_indices(i) * grid%h
          x = x - motion(7:9, b)
