@@ -1588,7 +1588,7 @@ contains
          end do
          if (found_structures == 2) then
             call status%fail(where//': variable between names two structures; name a material and a structure '// &
-                             '(structures are fixed: they cannot touch each other)')
+                             '(structures do not act on each other: each is fixed or moves as prescribed)')
             return
          end if
          do other = 1, c - 1

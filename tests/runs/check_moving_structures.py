@@ -15,7 +15,8 @@
    carries M g to 1e-9 at constant speed, and the impulse it gives over 0-0.6 s is M g t + M U to 1e-9
    (the rigid contact acts relative to the structure's velocity).
 5. Restart and ranks: the cylinder to t = 0.4 s stopped at step 610 and continued from its step-600
-   checkpoint writes loads.csv byte for byte; 1 and 2 ranks agree to 1e-10 of the largest force.
+   checkpoint writes loads.csv byte for byte, and is refused once cylinder.csv changed (one line naming
+   motion_checksum); 1 and 2 ranks agree to 1e-10 of the largest force.
 
 usage: check_moving_structures.py <flotsam> <mpiexec> <tests/runs/scenes> [<scripts folder>] [--figures DIR]"""
 

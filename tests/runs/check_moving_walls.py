@@ -258,8 +258,8 @@ def check_piston(checks, flotsam, scenes, ranks, figures, folder="moving_walls",
 def check_restart_and_ranks(checks, flotsam_path, mpiexec, scenes, folder="moving_walls", scene="piston.nml",
                             tables=("piston.csv",), end_time=0.6, interval=300, stop=610, label="piston"):
     """The piston to t = 0.6 s on 2 ranks, checkpoints every 300 steps; again stopped at step 610 and
-    continued from the step-600 checkpoint: loads.csv and gauges.csv rows byte for byte. And the same on 1
-    rank: loads within 1e-10 relative (of the largest force). Another scene of scenes/<folder> likewise
+    continued from the step-600 checkpoint: loads.csv and gauges.csv rows byte for byte; refused once the
+    table changed. And the same on 1 rank: loads within 1e-10 relative (of the largest force). Another scene of scenes/<folder> likewise
     (`tables`: its motion files, relative to that folder; check_moving_structures.py)."""
     import glob
     import h5py
@@ -312,6 +312,24 @@ def check_restart_and_ranks(checks, flotsam_path, mpiexec, scenes, folder="movin
         checks.check(rows["full"] == rows["split"] and len(rows["full"]) > 10,
                      f"{label} restart: {file}.csv rows byte for byte ({len(rows['full'])} lines)",
                      f"{len(rows['split'])} lines against {len(rows['full'])}")
+    # the table changes (a row appended that holds the last place a second longer: the same motion, other
+    # numbers): a restart from the newest checkpoint (the continuation removed the older ones) is refused
+    checkpoint = os.path.relpath(sorted(glob.glob(split.path("out", "checkpoints", "checkpoint_*.h5")))[-1],
+                                 split.workdir)
+    table = split.path(os.path.basename(tables[0]))
+    with open(table) as f:
+        original = f.read()
+    last = [line for line in original.splitlines() if line.strip() and not line.startswith(("#", "t"))][-1]
+    values = last.split(",")
+    with open(table, "w") as f:
+        f.write(original.rstrip("\n") + "\n" + ",".join([repr(float(values[0]) + 1.0)] + values[1:]) + "\n")
+    result = split.run("continue.nml", 2, "--restart", checkpoint)
+    with open(table, "w") as f:
+        f.write(original)
+    errors = [line for line in result.stderr.splitlines() if "flotsam: error:" in line]
+    checks.check(result.returncode == 2 and len(errors) == 1 and "motion_checksum" in errors[0],
+                 f"{label} restart: refused after the table changed (exit 2, one line naming motion_checksum)",
+                 f"exit {result.returncode}: {errors}")
     two = pd.read_csv(runs["full"].path("out", "loads.csv"), comment="#")
     one = pd.read_csv(runs["one"].path("out", "loads.csv"), comment="#")
     scale = float(np.abs(two.drop(columns="time").to_numpy()).max())
