@@ -259,8 +259,9 @@ def check_restart_and_ranks(checks, flotsam_path, mpiexec, scenes, folder="movin
                             tables=("piston.csv",), end_time=0.6, interval=300, stop=610, label="piston"):
     """The piston to t = 0.6 s on 2 ranks, checkpoints every 300 steps; again stopped at step 610 and
     continued from the step-600 checkpoint: loads.csv and gauges.csv rows byte for byte; refused once the
-    table changed. And the same on 1 rank: loads within 1e-10 relative (of the largest force). Another scene of scenes/<folder> likewise
-    (`tables`: its motion files, relative to that folder; check_moving_structures.py)."""
+    table changed. And the same on 1 rank: loads within 1e-10 relative (of the largest force). Another
+    scene of scenes/<folder> likewise (`tables`: its motion files, relative to that folder;
+    check_moving_structures.py)."""
     import glob
     import h5py
     folder = os.path.join(scenes, folder)
