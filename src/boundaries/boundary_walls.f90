@@ -17,9 +17,10 @@
 !>   no_slip    v := 0
 !>   prescribed v := v_0 (the feeder of an inlet, algorithms.md section 4.3)
 !> A wall may be active for a time window only (an inlet's opening and its closing wall).
-!> A `&wall` may move (wall_motion, docs/theory.md section 3.6): each step it is placed where its motion
-!> puts it at the step's start, its node list is rebuilt there, and the constraints act on the velocity
-!> relative to the wall's mean velocity v_w over the step; the safeguard uses its place at the step's end.
+!> A `&wall` or a `&structure` may move (wall_motion, docs/theory.md section 3.6): each step it is placed
+!> where its motion puts it at the step's start (a structure's shape translated), its node list is
+!> rebuilt there, and the constraints act on the velocity relative to its mean velocity v_w over the
+!> step; the safeguard uses its place at the step's end.
 !>
 !> Loads (docs/theory.md section 3.2, algorithms.md section 9.1): the constraint's change of nodal
 !> momentum m_i (v_i^c - v_i^*) and the safeguard's change of particle momentum m_p (v_p^c - v_p) are the
@@ -29,10 +30,10 @@
 module boundary_walls
    use kinds, only: rp
    use scene_description, only: wall_spec_t, grid_spec_t, structure_spec_t, wall_none, wall_no_slip, wall_friction
-   use shape_geometry, only: shape_t, shape_distance, shape_normal, shape_bounds
+   use shape_geometry, only: shape_t, shape_distance, shape_normal, shape_bounds, translated_shape
    use background_grid, only: grid_t
    use particle_set, only: particle_set_t
-   use wall_motion, only: wall_motion_t, motion_of_wall
+   use wall_motion, only: wall_motion_t, prescribed_motion
    use time_table, only: time_table_t
    implicit none
    private
@@ -73,12 +74,14 @@ module boundary_walls
       !> shaped: grid-frame bounding box of the shape (the safeguard's quick rejection)
       real(rp) :: box_lower(3) = -huge(1.0_rp), box_upper(3) = huge(1.0_rp)
       real(rp), allocatable :: node_normal(:, :)   !< shaped: unit normal at node nodes(i) (dim, i), grid frame
-      !> a moving wall: its motion, its point and extent in the scene (world frame), the grid-frame point its
-      !> node list was built at, and its mean velocity over the current step (grid frame)
+      !> a moving wall or structure: its motion, its point and extent (a structure: its shape) in the scene
+      !> (world frame), its displacement d (world) now and where its node list was built, and its mean
+      !> velocity over the current step (grid frame)
       logical :: moving = .false.
       type(wall_motion_t) :: motion
       real(rp) :: rest_point(3) = 0.0_rp, rest_lower(3) = 0.0_rp, rest_upper(3) = 0.0_rp
-      real(rp) :: nodes_point(3) = 0.0_rp
+      type(shape_t) :: rest_shape
+      real(rp) :: shift(3) = 0.0_rp, nodes_shift(3) = 0.0_rp
       real(rp) :: wall_velocity(3) = 0.0_rp
    end type wall_t
 
@@ -117,16 +120,15 @@ contains
       if (.not. (present(gravity) .and. present(time))) return
       do w = 1, size(specs)
          if (present(tables)) then
-            walls(w)%motion = motion_of_wall(specs(w), gravity, grid%dim, tables(w))
+            walls(w)%motion = prescribed_motion(specs(w)%motion, specs(w)%normal, gravity, grid%dim, tables(w))
          else
-            walls(w)%motion = motion_of_wall(specs(w), gravity, grid%dim)
+            walls(w)%motion = prescribed_motion(specs(w)%motion, specs(w)%normal, gravity, grid%dim)
          end if
          if (.not. walls(w)%motion%moving()) cycle
          walls(w)%moving = .true.
          walls(w)%rest_point = specs(w)%point
          walls(w)%rest_lower = specs(w)%lower
          walls(w)%rest_upper = specs(w)%upper
-         walls(w)%nodes_point = walls(w)%point
       end do
       call place_moving_walls(walls, grid, time)
       call refresh_moving_walls(walls, grid)
@@ -146,8 +148,8 @@ contains
       end do
    end subroutine build_walls_of
 
-   !> Put every moving wall where its motion has it at `time` (point and extent); the node lists are
-   !> left as they are (refresh_moving_walls).
+   !> Put every moving wall where its motion has it at `time` (point and extent; a structure: its shape and
+   !> box); the node lists are left as they are (refresh_moving_walls).
    subroutine place_moving_walls(walls, grid, time)
       type(wall_t), intent(inout) :: walls(:)
       type(grid_t), intent(in) :: grid
@@ -158,6 +160,12 @@ contains
       do w = 1, size(walls)
          if (.not. walls(w)%moving) cycle
          d = walls(w)%motion%displacement(time)
+         walls(w)%shift = d
+         if (walls(w)%shaped) then
+            walls(w)%shape = translated_shape(walls(w)%rest_shape, d, dim)
+            call set_structure_box(walls(w), grid)
+            cycle
+         end if
          walls(w)%point(1:dim) = grid%frame%grid_point(walls(w)%rest_point(1:dim) + d(1:dim))
          ! an unbounded side stays unbounded (huge + d rounds to huge)
          walls(w)%lower(1:dim) = walls(w)%rest_lower(1:dim) + d(1:dim)
@@ -195,9 +203,9 @@ contains
       end do
    end function moving_wall_speed
 
-   !> Rebuild the node list of each moving wall whose point differs from the one its list was built at.
-   !> Only the grid lines within the wall's depth are scanned when its normal is a grid axis (a piston:
-   !> a few lines of nodes per step), the rank's whole box otherwise.
+   !> Rebuild the node list of each moving wall whose displacement differs from the one its list was built
+   !> at. Only the grid lines within the wall's depth are scanned when its normal is a grid axis (a piston:
+   !> a few lines of nodes per step), the rank's whole box otherwise; a structure's box and depth.
    subroutine refresh_moving_walls(walls, grid)
       type(wall_t), intent(inout) :: walls(:)
       type(grid_t), intent(in) :: grid
@@ -205,7 +213,12 @@ contains
       real(rp) :: a, b
       do w = 1, size(walls)
          if (.not. walls(w)%moving) cycle
-         if (all(walls(w)%point == walls(w)%nodes_point) .and. allocated(walls(w)%nodes)) cycle
+         if (all(walls(w)%shift == walls(w)%nodes_shift) .and. allocated(walls(w)%nodes)) cycle
+         walls(w)%nodes_shift = walls(w)%shift
+         if (walls(w)%shaped) then
+            call find_structure_nodes(walls(w), grid)
+            cycle
+         end if
          lo = grid%node_lo
          hi = grid%node_hi
          k = walls(w)%axis
@@ -220,7 +233,6 @@ contains
          if (allocated(walls(w)%counted)) deallocate (walls(w)%counted)
          if (allocated(walls(w)%arm)) deallocate (walls(w)%arm)
          call find_wall_nodes(walls(w), grid, lo, hi)
-         walls(w)%nodes_point = walls(w)%point
       end do
    end subroutine refresh_moving_walls
 
@@ -261,19 +273,35 @@ contains
    end function condition_kind
 
    !> The structures of `&structure` groups appended to `walls`; structure s reports to loads.csv entry
-   !> first_load + s.
-   subroutine build_structures(specs, grid, first_load, walls)
+   !> first_load + s. With `gravity` (world frame) and `time`, a structure with a motion moves and is
+   !> placed where it is at `time` (`tables`: per spec, the table of a 'table' motion).
+   subroutine build_structures(specs, grid, first_load, walls, gravity, time, tables)
       type(structure_spec_t), intent(in) :: specs(:)
       type(grid_t), intent(in) :: grid
       integer, intent(in) :: first_load
       type(wall_t), allocatable, intent(inout) :: walls(:)
+      real(rp), intent(in), optional :: gravity(3), time
+      type(time_table_t), intent(in), optional :: tables(:)
       type(wall_t), allocatable :: structures(:)
       integer :: s
       allocate (structures(size(specs)))
       do s = 1, size(specs)
          structures(s) = make_structure(grid, specs(s)%shape, condition_kind(specs(s)%condition), specs(s)%friction, &
                                         first_load + s, specs(s)%moment_point)
+         if (.not. (present(gravity) .and. present(time))) cycle
+         if (present(tables)) then
+            structures(s)%motion = prescribed_motion(specs(s)%motion, specs(s)%motion%direction, gravity, grid%dim, &
+                                                     tables(s))
+         else
+            structures(s)%motion = prescribed_motion(specs(s)%motion, specs(s)%motion%direction, gravity, grid%dim)
+         end if
+         structures(s)%moving = structures(s)%motion%moving()
+         structures(s)%rest_shape = specs(s)%shape
       end do
+      if (present(gravity) .and. present(time)) then
+         call place_moving_walls(structures, grid, time)
+         call refresh_moving_walls(structures, grid)
+      end if
       walls = [walls, structures]
    end subroutine build_structures
 
@@ -286,12 +314,7 @@ contains
       integer, intent(in) :: kind, load
       real(rp), intent(in) :: friction, moment_point(3)
       type(wall_t) :: wall
-      integer :: dim, n, i, j, l, g(3), k, corner
-      integer, allocatable :: found(:)
-      logical, allocatable :: owned(:)
-      real(rp), allocatable :: normals(:, :)
-      real(rp) :: x(3), world(3), lower(3), upper(3), phi, reach
-
+      integer :: dim
       dim = grid%dim
       wall%shaped = .true.
       wall%shape = shape
@@ -301,10 +324,22 @@ contains
       wall%depth = wall_depth_in_cells(grid) * grid%h
       wall%moment_point = 0.0_rp
       wall%moment_point(1:dim) = grid%frame%grid_point(moment_point(1:dim))
-      ! the grid-frame box of the world box's corners holds the shape
-      call shape_bounds(shape, dim, lower, upper)
+      call set_structure_box(wall, grid)
+      call find_structure_nodes(wall, grid)
+   end function make_structure
+
+   !> A structure's grid-frame box (box_lower, box_upper): that of the corners of its shape's world box.
+   subroutine set_structure_box(wall, grid)
+      type(wall_t), intent(inout) :: wall
+      type(grid_t), intent(in) :: grid
+      integer :: dim, k, corner
+      real(rp) :: x(3), world(3), lower(3), upper(3)
+      dim = grid%dim
+      call shape_bounds(wall%shape, dim, lower, upper)
       wall%box_lower = huge(1.0_rp)
       wall%box_upper = -huge(1.0_rp)
+      x = 0.0_rp
+      world = 0.0_rp
       do corner = 0, 2**dim - 1
          do k = 1, dim
             world(k) = merge(upper(k), lower(k), btest(corner, k - 1))
@@ -313,30 +348,52 @@ contains
          wall%box_lower(1:dim) = min(wall%box_lower(1:dim), x(1:dim))
          wall%box_upper(1:dim) = max(wall%box_upper(1:dim), x(1:dim))
       end do
+   end subroutine set_structure_box
 
-      allocate (found(grid%node_count), owned(grid%node_count), normals(dim, grid%node_count))
+   !> The local nodes a structure constrains (-depth <= phi <= tolerance), with the shape's outward normal
+   !> at each (grid frame) and its loads' bookkeeping: only the nodes of its box widened by depth + h.
+   subroutine find_structure_nodes(wall, grid)
+      type(wall_t), intent(inout) :: wall
+      type(grid_t), intent(in) :: grid
+      integer :: dim, n, i, j, l, g(3), lo(3), hi(3)
+      integer, allocatable :: found(:)
+      logical, allocatable :: owned(:)
+      real(rp), allocatable :: normals(:, :)
+      real(rp) :: x(3), world(3), phi, reach
+
+      dim = grid%dim
+      reach = wall%depth + grid%h
+      lo = grid%node_lo
+      hi = grid%node_hi
+      ! the index range of the widened box (the test below decides; this only bounds the scan)
+      lo(1:dim) = max(lo(1:dim), floor((wall%box_lower(1:dim) - reach - grid%origin(1:dim)) / grid%h) - 1)
+      hi(1:dim) = min(hi(1:dim), ceiling((wall%box_upper(1:dim) + reach - grid%origin(1:dim)) / grid%h) + 1)
+      allocate (found(max(0, product(hi - lo + 1))), owned(max(0, product(hi - lo + 1))), &
+                normals(dim, max(0, product(hi - lo + 1))))
       n = 0
       x = 0.0_rp
-      reach = wall%depth + grid%h
-      do l = grid%node_lo(3), grid%node_hi(3)
-         do j = grid%node_lo(2), grid%node_hi(2)
-            do i = grid%node_lo(1), grid%node_hi(1)
+      world = 0.0_rp
+      do l = lo(3), hi(3)
+         do j = lo(2), hi(2)
+            do i = lo(1), hi(1)
                g = [i, j, l]
                x(1:dim) = grid%origin(1:dim) + g(1:dim) * grid%h
                if (any(x(1:dim) < wall%box_lower(1:dim) - reach) .or. any(x(1:dim) > wall%box_upper(1:dim) + reach)) cycle
                world(1:dim) = grid%frame%world_point(x(1:dim))
-               phi = shape_distance(shape, world(1:dim))
+               phi = shape_distance(wall%shape, world(1:dim))
                if (phi > on_wall_tolerance * grid%h .or. phi < -wall%depth) cycle
                n = n + 1
                found(n) = grid%local_node(g(1:dim))
                owned(n) = grid%owns_node(g(1:dim))
-               normals(:, n) = grid%frame%grid_vector(shape_normal(shape, world(1:dim), normal_step_in_cells * grid%h))
+               normals(:, n) = grid%frame%grid_vector(shape_normal(wall%shape, world(1:dim), &
+                                                                   normal_step_in_cells * grid%h))
             end do
          end do
       end do
+      if (allocated(wall%arm)) deallocate (wall%arm)
       call keep_nodes(wall, grid, found(1:n), owned(1:n))
       wall%node_normal = normals(:, 1:n)
-   end function make_structure
+   end subroutine find_structure_nodes
 
    !> The sides of the scene box that `&box_walls` makes walls, as `&wall` entries: each is the face of
    !> the box lower..lower + ncells h (world frame), with the normal pointing into the box.
@@ -692,7 +749,8 @@ contains
 
    !> The safeguard of a structure: a particle with phi < 0 moves to its foot point x - phi n on the
    !> surface (n = grad phi at x) and loses its normal velocity into the structure (friction: Coulomb's
-   !> share of the tangential one too). Unlike a wall's, it acts at any depth: a structure is solid.
+   !> share of the tangential one too); of a moving structure, of its velocity relative to v_w. Unlike a
+   !> wall's, it acts at any depth: a structure is solid.
    !> A particle put on a curved surface lands at phi = 0 only to round-off; counting it inside only below
    !> -on_wall_tolerance h keeps the next step's decision (and its change of velocity) from depending on
    !> that round-off, which differs with the number of ranks. With `field` (particle), a particle of body
@@ -710,10 +768,11 @@ contains
       real(rp), intent(inout), optional :: field_impulse(:, :)
       integer :: p, d, f, kind
       real(rp) :: world(particles%dim), phi, n(particles%dim), before(particles%dim), step, tolerance, mu
-      real(rp) :: dp(particles%dim)
+      real(rp) :: dp(particles%dim), relative(particles%dim), vw(particles%dim)
       d = particles%dim
       step = normal_step_in_cells * grid%h
       tolerance = on_wall_tolerance * grid%h
+      vw = wall%wall_velocity(1:d)
       do p = 1, particles%count
          if (any(particles%x(:, p) < wall%box_lower(1:d)) .or. any(particles%x(:, p) > wall%box_upper(1:d))) cycle
          world = grid%frame%world_point(particles%x(:, p))
@@ -722,8 +781,11 @@ contains
          if (skip(particles%material(p))) cycle
          n = grid%frame%grid_vector(shape_normal(wall%shape, world, step))
          particles%x(:, p) = particles%x(:, p) - phi * n
-         if (dot_product(particles%v(:, p), n) < 0.0_rp) then
-            before = particles%v(:, p)
+         ! a moving structure: the velocity relative to its own (a fixed one keeps its arithmetic)
+         before = particles%v(:, p)
+         relative = before
+         if (wall%moving) relative = before - vw
+         if (dot_product(relative, n) < 0.0_rp) then
             kind = wall%kind
             mu = wall%friction
             f = 0
@@ -735,9 +797,10 @@ contains
                end if
             end if
             if (kind == wall_kind_friction) then
-               particles%v(:, p) = unilateral_velocity(before, n, mu)
+               particles%v(:, p) = unilateral_velocity(relative, n, mu)
+               if (wall%moving) particles%v(:, p) = vw + particles%v(:, p)
             else
-               particles%v(:, p) = before - dot_product(before, n) * n
+               particles%v(:, p) = before - dot_product(relative, n) * n
             end if
             dp = particles%mass(p) * (particles%v(:, p) - before)
             call add_impulse(impulse, dp, particles%x(:, p) - wall%moment_point(1:d))

@@ -46,7 +46,7 @@ module shape_geometry
    end type shape_t
 
    public :: box_from_corners, vertex_count, polygon_vertices, shape_distance, shape_normal, shape_bounds, &
-             shape_measure, shape_problem, box_axes, polygon_area
+             shape_measure, shape_problem, box_axes, polygon_area, translated_shape, box_corners
 
 contains
 
@@ -58,6 +58,23 @@ contains
       shape%centre = 0.5_rp * (lower + upper)
       shape%size = upper - lower
    end function box_from_corners
+
+   !> `shape` with the centre and size of the box lower..upper (its first dim components; rotation kept).
+   pure function box_corners(shape, lower, upper, dim) result(box)
+      type(shape_t), intent(in) :: shape
+      real(rp), intent(in) :: lower(3), upper(3)
+      integer, intent(in) :: dim
+      type(shape_t) :: box, corners
+      real(rp) :: lo(3), up(3)
+      lo = 0.0_rp
+      up = 0.0_rp
+      lo(1:dim) = lower(1:dim)
+      up(1:dim) = upper(1:dim)
+      corners = box_from_corners(lo, up)
+      box = shape
+      box%centre(1:dim) = corners%centre(1:dim)
+      box%size(1:dim) = corners%size(1:dim)
+   end function box_corners
 
    !> Vertices given: the leading slots that hold one (a last vertex equal to the first is dropped).
    pure integer function vertex_count(shape) result(n)
@@ -149,6 +166,23 @@ contains
          normal = 0.0_rp
       end if
    end function shape_normal
+
+   !> The shape moved by the world vector d (its first dim components; a moving `&structure`): centre,
+   !> every vertex given (a closing copy of the first too) and, in 3-D, z_range.
+   pure function translated_shape(shape, d, dim) result(moved)
+      type(shape_t), intent(in) :: shape
+      real(rp), intent(in) :: d(3)
+      integer, intent(in) :: dim
+      type(shape_t) :: moved
+      integer :: v
+      moved = shape
+      moved%centre(1:dim) = shape%centre(1:dim) + d(1:dim)
+      do v = 1, max_vertices
+         if (any(shape%vertices(:, v) >= no_vertex)) exit
+         moved%vertices(:, v) = shape%vertices(:, v) + d(1:2)
+      end do
+      if (dim == 3) moved%z_range = shape%z_range + d(3)
+   end function translated_shape
 
    !> World-frame bounding box of the shape (exact for every kind).
    pure subroutine shape_bounds(shape, dim, lower, upper)

@@ -74,6 +74,7 @@ contains
       call broadcast_body_points(scene, counts(2), comm, root, rank)
       call broadcast_tables(scene%inlet_tables, counts(4), comm, root, rank)
       call broadcast_tables(scene%wall_tables, counts(3), comm, root, rank)
+      call broadcast_tables(scene%structure_tables, counts(7), comm, root, rank)
       if (rank == root) return
 
       at = 1
@@ -140,7 +141,8 @@ contains
       end do
    end subroutine broadcast_body_points
 
-   !> Time tables of the inlets or the walls (scene%inlet_tables, scene%wall_tables; none: unallocated):
+   !> Time tables of the inlets, the walls or the structures (scene%inlet_tables, wall_tables,
+   !> structure_tables; none: unallocated):
    !> per entry the numbers of columns and rows (-1: no table), then path, checksum, column names, times,
    !> values and lines.
    subroutine broadcast_tables(tables, entries, comm, root, rank)

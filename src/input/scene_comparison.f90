@@ -21,7 +21,7 @@ module scene_comparison
 
    !> What a restart may change without --allow-scene-change: when the run ends, what it writes where and
    !> how often, the blow-up speed limit and the load balancing; nothing of the physics or the particles.
-   !> `&body points_file`, `&inlet velocity_file` and `&wall motion_file` may name another path (the scene
+   !> `&body points_file`, `&inlet velocity_file` and `&wall` / `&structure motion_file` may name another path (the scene
    !> records it as an absolute path, so a moved folder changes it): their numbers are compared through
    !> `points_checksum`, `velocity_checksum` and `motion_checksum`, which may not change.
    !> Load balancing changes the order of sums, so a continuation that changes it equals an
@@ -31,7 +31,7 @@ module scene_comparison
       'run%particle_output', 'run%grid_output', 'run%progress_interval', 'run%floor_size', 'run%load_interval', &
       'run%checkpoint_interval_steps', 'run%checkpoint_interval_wall', 'run%checkpoints_kept', 'run%speed_limit', &
       'run%rebalance_threshold', 'run%rebalance_interval', 'body%points_file', 'inlet%velocity_file', &
-      'wall%motion_file']
+      'wall%motion_file', 'structure%motion_file']
 
    !> One difference: `material(1)%bulk_modulus: 2000000.0 -> 1000000.0`.
    type, public :: scene_change_t

@@ -2,7 +2,7 @@
 !> (documented group by group in docs/input.md). Only what is declared is modelled.
 module scene_description
    use kinds, only: rp, i8, path_len, name_len
-   use shape_geometry, only: shape_t
+   use shape_geometry, only: shape_t, box_corners
    use time_table, only: time_table_t
    implicit none
    private
@@ -20,7 +20,7 @@ module scene_description
    !> Unilateral with Coulomb friction (`&wall`, `&box_walls`, `&structure` with `friction` = mu).
    character(len=*), parameter, public :: wall_friction = 'friction'
 
-   !> `&wall motion=` keywords: a fixed wall, the piston stroke of a solitary wave (Goring 1978), a
+   !> `&wall motion=` and `&structure motion=` keywords: fixed, the piston stroke of a solitary wave (Goring 1978), a
    !> displacement read from a time table (docs/input.md).
    character(len=*), parameter, public :: motion_none = 'none'
    character(len=*), parameter, public :: motion_solitary_wave = 'solitary_wave'
@@ -87,6 +87,23 @@ module scene_description
       real(rp) :: wall_friction = 0.0_rp      !< Coulomb mu of the sides whose condition is 'friction'
    end type grid_spec_t
 
+   !> A prescribed rigid translation of a `&wall` or a `&structure` (wall_motion; docs/input.md): the
+   !> namelist variables motion, motion_start, wave_height, water_depth, motion_file, motion_checksum and
+   !> (a structure's solitary wave) motion_direction.
+   type, public :: motion_spec_t
+      character(len=name_len) :: kind = motion_none   !< `motion`: 'none', 'solitary_wave' or 'table'
+      real(rp) :: start = 0.0_rp              !< `motion_start`, solitary_wave: the stroke starts [s]
+      real(rp) :: wave_height = 0.0_rp        !< solitary_wave: wave height A [m]
+      real(rp) :: water_depth = 0.0_rp        !< solitary_wave: still-water depth h [m]
+      !> `motion_file`, table: CSV of the displacement (t, x, y[, z]); resolved to an absolute path
+      character(len=path_len) :: file = ''
+      !> `motion_checksum`, table: checksum of the numbers read from the file (16 hex digits); given: must match
+      character(len=16) :: checksum = ''
+      !> `motion_direction`, a structure's solitary_wave: the direction of the stroke, any length (a wall
+      !> moves along its normal)
+      real(rp) :: direction(3) = 0.0_rp
+   end type motion_spec_t
+
    !> `&wall`: a plane wall (a segment in 2-D, a planar patch in 3-D), world frame. The wall is the part
    !> of the plane through `point` with inward unit normal `normal` that lies inside the box lower..upper
    !> (unbounded by default). The solver turns the `&box_walls` sides into walls of this kind.
@@ -101,19 +118,12 @@ module scene_description
       !> point the moment of the wall's load is taken about [m]; huge: not given, resolved to the component
       !> of `point`
       real(rp) :: moment_point(3) = huge(1.0_rp)
-      !> prescribed rigid translation (wall_motion): 'none', 'solitary_wave' or 'table'
-      character(len=name_len) :: motion = motion_none
-      real(rp) :: motion_start = 0.0_rp       !< solitary_wave: the stroke starts [s]
-      real(rp) :: wave_height = 0.0_rp        !< solitary_wave: wave height A [m]
-      real(rp) :: water_depth = 0.0_rp        !< solitary_wave: still-water depth h [m]
-      !> table: CSV of the displacement (t, x, y[, z]); resolved to an absolute path
-      character(len=path_len) :: motion_file = ''
-      !> table: checksum of the numbers read from motion_file (16 hex digits); given: must match the file
-      character(len=16) :: motion_checksum = ''
+      type(motion_spec_t) :: motion           !< a prescribed rigid translation (motion, motion_start, ...)
    end type wall_spec_t
 
-   !> `&structure`: a fixed rigid obstacle of any shape and orientation (world frame) whose surface
-   !> constrains the material like a wall (unilateral; slip, no-slip or Coulomb friction).
+   !> `&structure`: a rigid obstacle of any shape and orientation (world frame) whose surface constrains
+   !> the material like a wall (unilateral; slip, no-slip or Coulomb friction); fixed, or translated by a
+   !> prescribed motion.
    type, public :: structure_spec_t
       character(len=name_len) :: name = ''    !< name in loads.csv; resolved default 'structure_<k>'
       type(shape_t) :: shape                  !< the obstacle (shape_geometry: negative distance inside)
@@ -125,6 +135,7 @@ module scene_description
       real(rp) :: friction = 0.0_rp           !< Coulomb coefficient mu of condition 'friction' [-]
       !> point the moment of its load is taken about [m]; huge: not given, resolved to the shape's centre
       real(rp) :: moment_point(3) = huge(1.0_rp)
+      type(motion_spec_t) :: motion           !< a prescribed rigid translation (as a &wall's)
    end type structure_spec_t
 
    !> `&inlet`: an opening through which fluid enters at a constant speed, or at the speed (and height) of
@@ -151,7 +162,8 @@ module scene_description
       logical :: hydrostatic = .false.        !< new particles carry the hydrostatic pressure below the stream top
    end type inlet_spec_t
 
-   public :: opening_tangent, opening_far_end, has_velocity_file, shifts_particles, relaxes_to_eos, writes_particle_field
+   public :: opening_tangent, opening_far_end, has_velocity_file, shifts_particles, relaxes_to_eos, writes_particle_field, &
+             structure_shape
 
    !> `&material`: one constitutive model and its parameters.
    type, public :: material_spec_t
@@ -244,6 +256,8 @@ module scene_description
       !> per wall, the table of its motion_file (read by rank 0, broadcast with the scene; empty otherwise)
       type(time_table_t), allocatable :: wall_tables(:)
       type(structure_spec_t), allocatable :: structures(:)   !< `&structure` groups
+      !> per structure, the table of its motion_file (as wall_tables)
+      type(time_table_t), allocatable :: structure_tables(:)
       type(inlet_spec_t), allocatable :: inlets(:)
       !> per inlet, the table of its velocity_file (read by rank 0, broadcast with the scene; no rows: none)
       type(time_table_t), allocatable :: inlet_tables(:)
@@ -288,6 +302,16 @@ contains
          start = start + comma
       end do
    end function writes_particle_field
+
+   !> The shape of a `&structure` (validated) in a `dim`-D scene: a box given by its corners lower..upper
+   !> as centre and size (resolve_scene stores it so).
+   pure function structure_shape(structure, dim) result(shape)
+      type(structure_spec_t), intent(in) :: structure
+      integer, intent(in) :: dim
+      type(shape_t) :: shape
+      shape = structure%shape
+      if (structure%lower(1) < huge(1.0_rp)) shape = box_corners(shape, structure%lower, structure%upper, dim)
+   end function structure_shape
 
    !> The inlet's speed (and height) follow the time table of its velocity_file.
    pure logical function has_velocity_file(inlet)

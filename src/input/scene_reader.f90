@@ -12,7 +12,8 @@ module scene_reader
    use kinds, only: rp, i8, path_len
    use error_status, only: status_t
    use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
-                                inlet_spec_t, gauge_spec_t, structure_spec_t, contact_spec_t, model_newtonian_fluid, &
+                                inlet_spec_t, gauge_spec_t, structure_spec_t, contact_spec_t, motion_spec_t, &
+                                model_newtonian_fluid, &
                                 model_linear_elastic, model_rigid
    use shape_geometry, only: shape_t, max_vertices, no_vertex
    use namelist_scan, only: namelist_file_t, namelist_group_t, scan_namelist_file
@@ -23,7 +24,7 @@ module scene_reader
    use input_text, only: lower_case, upper_case, int_text, ordinal, group_context, canonical_keyword
    use point_file, only: load_body_points
    use inlet_table, only: load_inlet_tables
-   use wall_motion, only: load_wall_tables
+   use wall_motion, only: load_motion_tables
    implicit none
    private
 
@@ -194,7 +195,14 @@ module scene_reader
       variable_info_t('structure', 'upper', 'real3', .false.), &
       variable_info_t('structure', 'condition', 'string', .false.), &
       variable_info_t('structure', 'friction', 'real', .false.), &
-      variable_info_t('structure', 'moment_point', 'real3', .false.)]
+      variable_info_t('structure', 'moment_point', 'real3', .false.), &
+      variable_info_t('structure', 'motion', 'string', .false.), &
+      variable_info_t('structure', 'motion_start', 'real', .false.), &
+      variable_info_t('structure', 'wave_height', 'real', .false.), &
+      variable_info_t('structure', 'water_depth', 'real', .false.), &
+      variable_info_t('structure', 'motion_direction', 'real3', .false.), &
+      variable_info_t('structure', 'motion_file', 'string', .false.), &
+      variable_info_t('structure', 'motion_checksum', 'string', .false.)]
 
    !> Namelist buffers of string values are longer than the scene's fields, so that a value too long
    !> for its field is reported instead of cut.
@@ -241,8 +249,8 @@ contains
          ! the points of `&body points_file` (checked like the scene's values, before any output)
          if (status%ok) call load_body_points(scene, label, status)
          if (status%ok) call load_inlet_tables(scene, label, status)
-         ! the tables of `&wall motion = 'table'` (the whole motion checked against the scene box)
-         if (status%ok) call load_wall_tables(scene, label, status)
+         ! the tables of `&wall` and `&structure motion = 'table'` (the whole motion checked against the scene box)
+         if (status%ok) call load_motion_tables(scene, label, status)
          if (status%ok) call resolve_scene(scene)
          ! before any particle is made: a scene too large for the machine is refused, not run out of memory
          if (status%ok) call check_scene_memory(scene, label, ranks, budget, status)
@@ -1160,7 +1168,7 @@ contains
       character(len=*), intent(in) :: text
       character(len=text_len) :: condition, name, motion, motion_file, motion_checksum
       real(rp) :: point(3), normal(3), lower(3), upper(3), moment_point(3), friction, motion_start, wave_height, &
-                  water_depth
+                  water_depth, motion_direction(3)
       namelist /wall/ point, normal, lower, upper, condition, friction, name, moment_point, motion, motion_start, &
          wave_height, water_depth, motion_file, motion_checksum
 
@@ -1172,22 +1180,14 @@ contains
       friction = spec%friction
       name = spec%name
       moment_point = spec%moment_point
-      motion = spec%motion
-      motion_file = spec%motion_file
-      motion_checksum = spec%motion_checksum
-      motion_start = spec%motion_start
-      wave_height = spec%wave_height
-      water_depth = spec%water_depth
+      call motion_to_locals(spec%motion, motion, motion_start, wave_height, water_depth, motion_direction, motion_file, &
+                            motion_checksum)
       read (text, nml=wall, iostat=ios, iomsg=message)
       call take_text('condition', condition, spec%condition, ios, message, fold='lower')
       call take_text('name', name, spec%name, ios, message)
-      call take_text('motion', motion, spec%motion, ios, message, fold='lower')
-      call take_text('motion_file', motion_file, spec%motion_file, ios, message)
-      call take_text('motion_checksum', motion_checksum, spec%motion_checksum, ios, message, fold='lower')
+      call take_motion(motion, motion_start, wave_height, water_depth, motion_direction, motion_file, motion_checksum, &
+                       spec%motion, ios, message)
       if (ios /= 0) return
-      spec%motion_start = motion_start
-      spec%wave_height = wave_height
-      spec%water_depth = water_depth
       spec%point = point
       spec%normal = normal
       spec%lower = lower
@@ -1203,11 +1203,13 @@ contains
       integer, intent(out) :: ios
       character(len=*), intent(inout) :: message
       character(len=*), intent(in) :: text
-      character(len=text_len) :: name, shape, condition
+      character(len=text_len) :: name, shape, condition, motion, motion_file, motion_checksum
       real(rp) :: centre(3), size(3), rotation, rotation_axis(3), radius, axis(3), length, vertices(2 * max_vertices), &
-                  z_range(2), lower(3), upper(3), friction, moment_point(3)
+                  z_range(2), lower(3), upper(3), friction, moment_point(3), motion_start, wave_height, water_depth, &
+                  motion_direction(3)
       namelist /structure/ name, shape, centre, size, rotation, rotation_axis, radius, axis, length, vertices, z_range, &
-         lower, upper, condition, friction, moment_point
+         lower, upper, condition, friction, moment_point, motion, motion_start, wave_height, water_depth, &
+         motion_direction, motion_file, motion_checksum
 
       name = spec%name
       shape = spec%shape%kind
@@ -1217,10 +1219,14 @@ contains
       condition = spec%condition
       friction = spec%friction
       moment_point = spec%moment_point
+      call motion_to_locals(spec%motion, motion, motion_start, wave_height, water_depth, motion_direction, motion_file, &
+                            motion_checksum)
       read (text, nml=structure, iostat=ios, iomsg=message)
       call take_text('name', name, spec%name, ios, message)
       call take_text('shape', shape, spec%shape%kind, ios, message, fold='lower')
       call take_text('condition', condition, spec%condition, ios, message, fold='lower')
+      call take_motion(motion, motion_start, wave_height, water_depth, motion_direction, motion_file, motion_checksum, &
+                       spec%motion, ios, message)
       if (ios /= 0) return
       call locals_to_shape(centre, size, rotation, rotation_axis, radius, axis, length, vertices, z_range, spec%shape)
       spec%lower = lower
@@ -1228,6 +1234,39 @@ contains
       spec%friction = friction
       spec%moment_point = moment_point
    end subroutine read_structure_group
+
+   !> The variables of a prescribed motion (`&wall`, `&structure`) as namelist variables.
+   pure subroutine motion_to_locals(spec, motion, motion_start, wave_height, water_depth, motion_direction, &
+                                    motion_file, motion_checksum)
+      type(motion_spec_t), intent(in) :: spec
+      character(len=*), intent(out) :: motion, motion_file, motion_checksum
+      real(rp), intent(out) :: motion_start, wave_height, water_depth, motion_direction(3)
+      motion = spec%kind
+      motion_start = spec%start
+      wave_height = spec%wave_height
+      water_depth = spec%water_depth
+      motion_direction = spec%direction
+      motion_file = spec%file
+      motion_checksum = spec%checksum
+   end subroutine motion_to_locals
+
+   !> The namelist variables read back into the motion (see motion_to_locals; take_text for the strings).
+   subroutine take_motion(motion, motion_start, wave_height, water_depth, motion_direction, motion_file, &
+                          motion_checksum, spec, ios, message)
+      character(len=*), intent(in) :: motion, motion_file, motion_checksum
+      real(rp), intent(in) :: motion_start, wave_height, water_depth, motion_direction(3)
+      type(motion_spec_t), intent(inout) :: spec
+      integer, intent(inout) :: ios
+      character(len=*), intent(inout) :: message
+      call take_text('motion', motion, spec%kind, ios, message, fold='lower')
+      call take_text('motion_file', motion_file, spec%file, ios, message)
+      call take_text('motion_checksum', motion_checksum, spec%checksum, ios, message, fold='lower')
+      if (ios /= 0) return
+      spec%start = motion_start
+      spec%wave_height = wave_height
+      spec%water_depth = water_depth
+      spec%direction = motion_direction
+   end subroutine take_motion
 
    !> The numbers of a shape as the namelist variables of a group that takes one (&body, &structure). The
    !> vertices start empty: a list that is read replaces the shape's whole list (an override with fewer

@@ -10,7 +10,7 @@
 !> `transfer = 'apic'`, which refuses it.
 module scene_record
    use kinds, only: rp
-   use scene_description, only: scene_t
+   use scene_description, only: scene_t, motion_spec_t
    use shape_geometry, only: no_vertex
    use scene_reader, only: known_groups, group_variables, entry_count
    use input_text, only: int_text, real_text
@@ -346,23 +346,36 @@ contains
             text = quoted(wall%name)
          case ('moment_point')
             text = reals(wall%moment_point)
-         case ('motion')
-            text = quoted(wall%motion)
-         case ('motion_start')
-            text = real_text(wall%motion_start)
-         case ('wave_height')
-            text = real_text(wall%wave_height)
-         case ('water_depth')
-            text = real_text(wall%water_depth)
-         case ('motion_file')
-            text = quoted(wall%motion_file)
-         case ('motion_checksum')
-            text = quoted(wall%motion_checksum)
          case default
-            text = ''
+            text = motion_value(wall%motion, name)
          end select
       end associate
    end function wall_value
+
+   !> A variable of the prescribed motion of a `&wall` or a `&structure`; '' for another variable.
+   function motion_value(motion, name) result(text)
+      type(motion_spec_t), intent(in) :: motion
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: text
+      select case (name)
+      case ('motion')
+         text = quoted(motion%kind)
+      case ('motion_start')
+         text = real_text(motion%start)
+      case ('wave_height')
+         text = real_text(motion%wave_height)
+      case ('water_depth')
+         text = real_text(motion%water_depth)
+      case ('motion_direction')
+         text = reals(motion%direction)
+      case ('motion_file')
+         text = quoted(motion%file)
+      case ('motion_checksum')
+         text = quoted(motion%checksum)
+      case default
+         text = ''
+      end select
+   end function motion_value
 
    function inlet_value(scene, k, name) result(text)
       type(scene_t), intent(in) :: scene
@@ -483,7 +496,7 @@ contains
          case ('moment_point')
             text = reals(structure%moment_point)
          case default
-            text = ''
+            text = motion_value(structure%motion, name)
          end select
       end associate
    end function structure_value

@@ -8,18 +8,18 @@ module scene_validation
    use error_status, only: status_t
    use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
                                 inlet_spec_t, gauge_spec_t, contact_spec_t, structure_spec_t, opening_far_end, wall_none, &
-                                has_velocity_file, &
+                                has_velocity_file, motion_spec_t, structure_shape, &
                                 wall_slip, wall_no_slip, wall_friction, motion_none, motion_solitary_wave, motion_table, &
                                 model_newtonian_fluid, model_linear_elastic, model_rigid, gauge_pressure, gauge_level, &
                                 gauge_velocity, &
                                 particle_field_names, field_precision_keywords
    use input_text, only: int_text, real_text, quoted_list, group_context, ordinal
    use memory_budget, only: memory_budget_t, byte_text
-   use shape_geometry, only: shape_t, shape_problem, shape_bounds, box_from_corners, polygon_vertices, polygon_area, &
+   use shape_geometry, only: shape_t, shape_problem, shape_bounds, box_corners, polygon_vertices, polygon_area, &
                              max_vertices, no_vertex, shape_box, shape_circle, shape_sphere, shape_cylinder, &
                              shape_polygon, shape_extruded_polygon
    use body_lattice, only: has_points_file, box_corners_given, body_shape, body_bounds, count_particles, particle_spacing
-   use wall_motion, only: wall_motion_t, motion_of_wall
+   use wall_motion, only: wall_motion_t, prescribed_motion
    implicit none
    private
 
@@ -143,7 +143,7 @@ contains
       end if
       if (allocated(scene%structures)) then
          do i = 1, size(scene%structures)
-            call validate_structure(scene%structures(i), i, scene%grid, path, status)
+            call validate_structure(scene%structures(i), i, scene, path, status)
             if (.not. status%ok) return
          end do
       end if
@@ -409,7 +409,7 @@ contains
             if (len_trim(structure%name) == 0) structure%name = default_name('structure', i)
             ! a box given by its corners becomes centre and size (validated: both corners, no centre/size)
             if (structure%lower(1) < huge(1.0_rp)) then
-               structure%shape = box_corners(structure%shape, structure%lower, structure%upper, scene%grid%dim)
+               structure%shape = structure_shape(structure, scene%grid%dim)
                structure%lower = huge(1.0_rp)
                structure%upper = huge(1.0_rp)
             end if
@@ -1150,67 +1150,86 @@ contains
                           ", got '"//trim(wall%condition)//"'")
       end if
       call check_friction(where, wall%condition, wall%friction, status)
-      call validate_wall_motion(wall, where, scene, status)
+      call validate_motion(wall%motion, where, 'wall', wall%point, wall%point, wall%normal, scene, status)
    end subroutine validate_wall
 
-   !> `&wall motion`: a known keyword; its variables given only with it; the solitary wave's height and
-   !> depth in range (A/h in (0, max_wave_ratio], gravity not zero); the whole motion keeps the wall's
-   !> point in the scene box.
-   subroutine validate_wall_motion(wall, where, scene, status)
-      type(wall_spec_t), intent(in) :: wall
-      character(len=*), intent(in) :: where
+   !> `&wall motion`, `&structure motion`: a known keyword; its variables given only with it; the solitary
+   !> wave's height and depth in range (A/h in (0, max_wave_ratio], gravity not zero) and its direction
+   !> (a wall's `normal`; a structure's motion_direction, required and not zero); the whole stroke keeps
+   !> the wall's point (`what` = 'wall', lower = upper) or the structure's box lower..upper (world, at
+   !> rest) in the scene box. A table is checked against the scene box when it is read (load_motion_tables).
+   subroutine validate_motion(spec, where, what, lower, upper, direction, scene, status)
+      type(motion_spec_t), intent(in) :: spec
+      character(len=*), intent(in) :: where, what
+      real(rp), intent(in) :: lower(3), upper(3), direction(3)
       type(scene_t), intent(in) :: scene
       type(status_t), intent(inout) :: status
       type(wall_motion_t) :: motion
-      real(rp) :: g, moved(3), box_lower(3), box_upper(3), tolerance
+      real(rp) :: g, low(3), high(3), box_lower(3), box_upper(3), tolerance
       integer :: k, dim
+      character(len=:), allocatable :: reach
       if (.not. status%ok) return
       dim = scene%grid%dim
-      if (all(wall%motion /= motion_keywords)) then
+      if (all(spec%kind /= motion_keywords)) then
          call status%fail(where//': variable motion must be one of '//quoted_list(motion_keywords)//", got '"// &
-                          trim(wall%motion)//"'")
+                          trim(spec%kind)//"'")
          return
       end if
-      if (wall%motion /= motion_solitary_wave) then
-         if (wall%wave_height /= 0.0_rp) call refuse('wave_height')
-         if (wall%water_depth /= 0.0_rp) call refuse('water_depth')
+      if (spec%kind /= motion_solitary_wave) then
+         if (spec%wave_height /= 0.0_rp) call refuse('wave_height')
+         if (spec%water_depth /= 0.0_rp) call refuse('water_depth')
+         if (any(spec%direction /= 0.0_rp)) call refuse('motion_direction')
       end if
-      if (wall%motion == motion_none .and. wall%motion_start /= 0.0_rp) call refuse('motion_start')
-      if (wall%motion /= motion_table) then
-         if (len_trim(wall%motion_file) > 0) call refuse('motion_file')
-         if (len_trim(wall%motion_checksum) > 0) call refuse('motion_checksum')
-      else if (len_trim(wall%motion_file) == 0) then
+      if (spec%kind == motion_none .and. spec%start /= 0.0_rp) call refuse('motion_start')
+      if (spec%kind /= motion_table) then
+         if (len_trim(spec%file) > 0) call refuse('motion_file')
+         if (len_trim(spec%checksum) > 0) call refuse('motion_checksum')
+      else if (len_trim(spec%file) == 0) then
          call status%fail(where//": variable motion_file is required with motion = '"//motion_table// &
-                          "' (a CSV of t, x, y[, z]: the wall's displacement)")
+                          "' (a CSV of t, x, y[, z]: the "//what//"'s displacement)")
       end if
-      if (wall%motion == motion_table .and. wall%motion_start /= 0.0_rp) then
+      if (spec%kind == motion_table .and. spec%start /= 0.0_rp) then
          call status%fail(where//": variable motion_start belongs to motion = '"//motion_solitary_wave// &
                           "' (a table gives its own times)")
       end if
-      ! a table is checked against the scene box when it is read (load_wall_tables)
-      if (.not. status%ok .or. wall%motion == motion_none .or. wall%motion == motion_table) return
-      call check_real(where, 'motion_start', wall%motion_start, status, at_least=0.0_rp)
-      if (.not. status%ok) return
-      if (wall%motion == motion_solitary_wave) then
-         call check_real(where, 'water_depth', wall%water_depth, status, greater_than=0.0_rp)
-         call check_real(where, 'wave_height', wall%wave_height, status, greater_than=0.0_rp, &
-                         at_most=max_wave_ratio * wall%water_depth)
-         g = norm2(scene%gravity(1:dim))
-         if (status%ok .and. g <= 0.0_rp) call status%fail(where//": variable motion = '"//motion_solitary_wave// &
-                                                           "' needs gravity (&gravity acceleration is zero)")
-         if (.not. status%ok) return
-         motion = motion_of_wall(wall, scene%gravity, dim)
-         ! the stroke is monotonic along the normal: its end is the farthest point
-         moved = wall%point + motion%stroke() * motion%direction
+      if (.not. status%ok .or. spec%kind /= motion_solitary_wave) return
+      call check_real(where, 'motion_start', spec%start, status, at_least=0.0_rp)
+      call check_real(where, 'water_depth', spec%water_depth, status, greater_than=0.0_rp)
+      call check_real(where, 'wave_height', spec%wave_height, status, greater_than=0.0_rp, &
+                      at_most=max_wave_ratio * spec%water_depth)
+      g = norm2(scene%gravity(1:dim))
+      if (status%ok .and. g <= 0.0_rp) call status%fail(where//": variable motion = '"//motion_solitary_wave// &
+                                                        "' needs gravity (&gravity acceleration is zero)")
+      if (what == 'structure') then
+         do k = 1, dim
+            call check_real(where, 'motion_direction('//int_text(k)//')', spec%direction(k), status)
+         end do
+         if (status%ok .and. .not. norm2(spec%direction(1:dim)) > 0.0_rp) &
+            call status%fail(where//": variable motion_direction is required with motion = '"//motion_solitary_wave// &
+                             "' (the direction of the stroke, not zero)")
       end if
+      if (.not. status%ok) return
+      if (what == 'structure') then
+         motion = prescribed_motion(spec, spec%direction, scene%gravity, dim)
+      else
+         motion = prescribed_motion(spec, direction, scene%gravity, dim)
+      end if
+      ! the stroke is monotonic along its direction: its end is the farthest place
+      low = lower + motion%stroke() * motion%direction
+      high = upper + motion%stroke() * motion%direction
       box_lower = scene%grid%origin
       box_upper = scene%grid%origin + scene%grid%extent
       tolerance = 1.0e-9_rp * scene%grid%cell_size
       do k = 1, dim
-         if (moved(k) < box_lower(k) - tolerance .or. moved(k) > box_upper(k) + tolerance) then
-            call status%fail(where//": variable motion = '"//trim(wall%motion)//"' drives the wall out of the scene "// &
-                             'box of &grid: its point('//int_text(k)//') reaches '//real_text(moved(k))// &
-                             ', the box is '//real_text(box_lower(k))//' .. '//real_text(box_upper(k)))
+         if (low(k) < box_lower(k) - tolerance .or. high(k) > box_upper(k) + tolerance) then
+            if (what == 'wall') then
+               reach = 'its point('//int_text(k)//') reaches '//real_text(low(k))
+            else
+               reach = 'it spans '//axis_letter(k)//' = '//real_text(low(k))//' .. '//real_text(high(k))
+            end if
+            call status%fail(where//": variable motion = '"//trim(spec%kind)//"' drives the "//what//' out of the '// &
+                             'scene box of &grid: '//reach//', the box is '//real_text(box_lower(k))//' .. '// &
+                             real_text(box_upper(k)))
             return
          end if
       end do
@@ -1221,15 +1240,15 @@ contains
          character(len=*), intent(in) :: variable
          character(len=:), allocatable :: owner
          if (.not. status%ok) return
-         ! motion_start belongs to every motion, the others to the solitary wave
+         ! motion_start belongs to every motion, motion_file and motion_checksum to the table, the others
+         ! to the solitary wave
          owner = "motion = '"//motion_solitary_wave//"'"
          if (variable == 'motion_start') owner = 'a motion'
-         if (variable(1:min(7, len(variable))) == 'motion_' .and. variable /= 'motion_start') &
-            owner = "motion = '"//motion_table//"'"
+         if (variable == 'motion_file' .or. variable == 'motion_checksum') owner = "motion = '"//motion_table//"'"
          call status%fail(where//': variable '//variable//' belongs to '//owner//", which is not given (motion = '"// &
-                          trim(wall%motion)//"')")
+                          trim(spec%kind)//"')")
       end subroutine refuse
-   end subroutine validate_wall_motion
+   end subroutine validate_motion
 
    !> mu >= 0, and given only with condition 'friction' (elsewhere it would be silently unused).
    subroutine check_friction(where, condition, friction, status)
@@ -1244,11 +1263,11 @@ contains
    end subroutine check_friction
 
    !> A structure: its name, condition and friction, the shape's parameters (shape_problem), a box by its
-   !> corners or by centre and size (not both), and the whole shape inside the scene box.
-   subroutine validate_structure(structure, s, grid, path, status)
+   !> corners or by centre and size (not both), the whole shape inside the scene box, and its motion.
+   subroutine validate_structure(structure, s, scene, path, status)
       type(structure_spec_t), intent(in) :: structure
       integer, intent(in) :: s
-      type(grid_spec_t), intent(in) :: grid
+      type(scene_t), intent(in) :: scene
       character(len=*), intent(in) :: path
       type(status_t), intent(inout) :: status
       character(len=:), allocatable :: where, problem
@@ -1257,7 +1276,7 @@ contains
       integer :: k, dim, v
       logical :: corners
 
-      dim = grid%dim
+      dim = scene%grid%dim
       where = group_context(path, 'structure', s, name_detail(structure%name))
       call check_name(where, 'name', structure%name, status)
       if (.not. status%ok) return
@@ -1331,34 +1350,18 @@ contains
 
       ! the scene box is axis-aligned in the world frame, whatever the grid's rotation (as for &gauge)
       call shape_bounds(shape, dim, lower, upper)
-      tolerance = inside_tolerance * grid%cell_size
+      tolerance = inside_tolerance * scene%grid%cell_size
       do k = 1, dim
-         top = grid%origin(k) + grid%extent(k)
-         if (lower(k) < grid%origin(k) - tolerance .or. upper(k) > top + tolerance) then
+         top = scene%grid%origin(k) + scene%grid%extent(k)
+         if (lower(k) < scene%grid%origin(k) - tolerance .or. upper(k) > top + tolerance) then
             call status%fail(where//': variables '//shape_variables(shape%kind, corners)//' put the structure '// &
                              'outside the scene box of &grid: it spans '//axis_letter(k)//' = '//real_text(lower(k))// &
-                             ' .. '//real_text(upper(k))//', the box '//real_text(grid%origin(k))//' .. '//real_text(top))
+                             ' .. '//real_text(upper(k))//', the box '//real_text(scene%grid%origin(k))//' .. '//real_text(top))
             return
          end if
       end do
+      call validate_motion(structure%motion, where, 'structure', lower, upper, structure%motion%direction, scene, status)
    end subroutine validate_structure
-
-   !> `shape` with the centre and size of the box lower..upper (its first dim components; rotation kept).
-   pure function box_corners(shape, lower, upper, dim) result(box)
-      type(shape_t), intent(in) :: shape
-      real(rp), intent(in) :: lower(3), upper(3)
-      integer, intent(in) :: dim
-      type(shape_t) :: box, corners
-      real(rp) :: lo(3), up(3)
-      lo = 0.0_rp
-      up = 0.0_rp
-      lo(1:dim) = lower(1:dim)
-      up(1:dim) = upper(1:dim)
-      corners = box_from_corners(lo, up)
-      box = shape
-      box%centre(1:dim) = corners%centre(1:dim)
-      box%size(1:dim) = corners%size(1:dim)
-   end function box_corners
 
    !> The value that marks the end of a vertex list (a NaN is a value given, and reported as such).
    elemental logical function is_none(value)
@@ -1585,7 +1588,7 @@ contains
          end do
          if (found_structures == 2) then
             call status%fail(where//': variable between names two structures; name a material and a structure '// &
-                             '(structures are fixed: they cannot touch each other)')
+                             '(structures do not act on each other: each is fixed or moves as prescribed)')
             return
          end if
          do other = 1, c - 1

@@ -1,11 +1,13 @@
-!> Prescribed rigid translations of walls (`&wall motion`, docs/input.md; docs/theory.md section 3.6).
+!> Prescribed rigid translations of walls and structures (`&wall motion`, `&structure motion`,
+!> docs/input.md; docs/theory.md section 3.6).
 !>
-!> The displacement d(t) of a wall from its position in the scene is a function of time alone: a
-!> restart needs no state. Kinds:
+!> The displacement d(t) of a wall or a structure from its position in the scene is a function of time
+!> alone: a restart needs no state. Kinds:
 !>  - none: d = 0.
 !>  - solitary_wave: the piston stroke of Goring (1978) that makes a solitary wave of height A in water
 !>    of depth h, eta = A sech^2(theta), theta = k (c (t - t_s) - x) - theta_0, k = sqrt(3 A / (4 h^3)),
-!>    c = sqrt(g (h + A)), x measured along the wall's normal from its position in the scene. The paddle
+!>    c = sqrt(g (h + A)), x measured along the wall's normal (a structure: its motion_direction) from its
+!>    position in the scene. The paddle
 !>    follows dX/dt = c eta(X, t) / (h + eta(X, t)). Along the paddle's path dtheta/dt = k c h / (h + eta)
 !>    and dX/dtheta = eta / (k h), which integrate in closed form [D]:
 !>       X(theta) = (A / (k h)) (tanh theta + tanh theta_0)
@@ -23,7 +25,8 @@
 module wall_motion
    use kinds, only: rp, path_len
    use error_status, only: status_t
-   use scene_description, only: scene_t, wall_spec_t, motion_solitary_wave, motion_table
+   use scene_description, only: scene_t, grid_spec_t, motion_spec_t, motion_solitary_wave, motion_table, structure_shape
+   use shape_geometry, only: shape_bounds
    use time_table, only: time_table_t, read_time_table
    use csv_table, only: beside
    use input_text, only: group_context, int_text, real_text
@@ -53,7 +56,7 @@ module wall_motion
       procedure :: end_time => motion_end_time
    end type wall_motion_t
 
-   public :: solitary_motion, motion_of_wall, load_wall_tables
+   public :: solitary_motion, prescribed_motion, load_motion_tables
 
 contains
 
@@ -71,25 +74,26 @@ contains
       motion%celerity = sqrt(g * (depth + amplitude))
    end function solitary_motion
 
-   !> The motion of a `&wall` (validated) under the world gravity vector `gravity` of a `dim`-D scene;
-   !> `table` the table of its motion_file (load_wall_tables).
-   pure function motion_of_wall(spec, gravity, dim, table) result(motion)
-      type(wall_spec_t), intent(in) :: spec
-      real(rp), intent(in) :: gravity(3)
+   !> The motion `spec` of a `&wall` or a `&structure` (validated) under the world gravity vector `gravity`
+   !> of a `dim`-D scene; `direction` (world, any length) the solitary stroke's (a wall's normal, a
+   !> structure's motion_direction); `table` the table of its motion_file (load_motion_tables).
+   pure function prescribed_motion(spec, direction, gravity, dim, table) result(motion)
+      type(motion_spec_t), intent(in) :: spec
+      real(rp), intent(in) :: direction(3), gravity(3)
       integer, intent(in) :: dim
       type(time_table_t), intent(in), optional :: table
       type(wall_motion_t) :: motion
-      real(rp) :: normal(3)
-      if (spec%motion == motion_table .and. present(table)) then
+      real(rp) :: unit(3)
+      if (spec%kind == motion_table .and. present(table)) then
          motion%kind = motion_kind_table
          motion%table = table
          return
       end if
-      if (spec%motion /= motion_solitary_wave) return
-      normal = 0.0_rp
-      normal(1:dim) = spec%normal(1:dim) / norm2(spec%normal(1:dim))
-      motion = solitary_motion(normal, spec%motion_start, spec%wave_height, spec%water_depth, norm2(gravity(1:dim)))
-   end function motion_of_wall
+      if (spec%kind /= motion_solitary_wave) return
+      unit = 0.0_rp
+      unit(1:dim) = direction(1:dim) / norm2(direction(1:dim))
+      motion = solitary_motion(unit, spec%start, spec%wave_height, spec%water_depth, norm2(gravity(1:dim)))
+   end function prescribed_motion
 
    !> The wall moves at all (a fixed wall keeps its nodes and its arithmetic).
    pure logical function motion_moving(self)
@@ -165,73 +169,110 @@ contains
       speed = self%celerity * eta / (self%depth + eta)
    end function motion_max_speed
 
-   !> Rank 0, after validate_scene: read the table of every `&wall motion = 'table'` into
-   !> scene%wall_tables (columns x, y[, z]: the displacement from the wall's place in the scene), check
-   !> that no row drives the wall's point out of the scene box, set motion_file to the absolute path read
-   !> and motion_checksum (a given one must match). A relative motion_file is relative to the scene file.
-   subroutine load_wall_tables(scene, label, status)
+   !> Rank 0, after validate_scene: read the table of every `&wall` and `&structure` with motion = 'table'
+   !> into scene%wall_tables / scene%structure_tables (columns x, y[, z]: the displacement from the place
+   !> in the scene), check that no row drives the wall's point or the structure's shape out of the scene
+   !> box, set motion_file to the absolute path read and motion_checksum (a given one must match). A
+   !> relative motion_file is relative to the scene file.
+   subroutine load_motion_tables(scene, label, status)
       type(scene_t), intent(inout) :: scene
       character(len=*), intent(in) :: label
       type(status_t), intent(inout) :: status
-      character(len=*), parameter :: axes(3) = ['x', 'y', 'z']
-      character(len=:), allocatable :: where
-      character(len=1024) :: message
-      real(rp) :: box_lower(3), box_upper(3), tolerance, moved
-      integer :: w, dim, r, k
-
-      if (.not. allocated(scene%walls)) return
-      dim = scene%grid%dim
-      if (allocated(scene%wall_tables)) deallocate (scene%wall_tables)
-      allocate (scene%wall_tables(size(scene%walls)))
-      tolerance = 1.0e-9_rp * scene%grid%cell_size
-      box_lower = scene%grid%origin
-      box_upper = scene%grid%origin + scene%grid%extent
-      do w = 1, size(scene%walls)
-         associate (wall => scene%walls(w), table => scene%wall_tables(w))
-            if (wall%motion /= motion_table) cycle
-            where = group_context(label, 'wall', w, wall_detail(wall%name))// &
-                    ": variable motion_file = '"//trim(wall%motion_file)//"'"
-            call read_time_table(beside(scene%source_file, trim(wall%motion_file)), axes(1:dim), table, message)
-            if (len_trim(message) > 0) then
-               call status%fail(where//': '//trim(message))
-               return
-            end if
-            if (len_trim(wall%motion_checksum) > 0 .and. trim(wall%motion_checksum) /= table%checksum) then
-               call status%fail(where//': '//trim(table%path)//": the table does not match motion_checksum = '"// &
-                                trim(wall%motion_checksum)//"' (the file gives '"//table%checksum// &
-                                "'): the file changed since the scene was written")
-               return
-            end if
-            ! the wall moves rigidly: its point stays in the box at every row (linear in between)
-            do r = 1, size(table%time)
-               do k = 1, dim
-                  moved = wall%point(k) + table%values(k, r)
-                  if (moved < box_lower(k) - tolerance .or. moved > box_upper(k) + tolerance) then
-                     call status%fail(where//": the motion drives the wall out of the scene box of &grid: at t = "// &
-                                      real_text(table%time(r))//' s its point('//int_text(k)//') reaches '// &
-                                      real_text(moved)//', the box is '//real_text(box_lower(k))//' .. '// &
-                                      real_text(box_upper(k)))
-                     return
-                  end if
-               end do
-            end do
-            if (len_trim(table%path) > path_len) then
-               call status%fail(where//': the path is longer than '//int_text(path_len)//' characters')
-               return
-            end if
-            wall%motion_file = table%path
-            wall%motion_checksum = table%checksum
+      real(rp) :: lower(3), upper(3)
+      integer :: w, s
+      if (allocated(scene%walls)) then
+         if (allocated(scene%wall_tables)) deallocate (scene%wall_tables)
+         allocate (scene%wall_tables(size(scene%walls)))
+         do w = 1, size(scene%walls)
+            associate (wall => scene%walls(w))
+               if (wall%motion%kind /= motion_table) cycle
+               call load_motion_table(scene%source_file, scene%grid, group_context(label, 'wall', w, named(wall%name)), &
+                                      'wall', wall%point, wall%point, wall%motion, scene%wall_tables(w), status)
+            end associate
+            if (.not. status%ok) return
+         end do
+      end if
+      if (.not. allocated(scene%structures)) return
+      if (allocated(scene%structure_tables)) deallocate (scene%structure_tables)
+      allocate (scene%structure_tables(size(scene%structures)))
+      do s = 1, size(scene%structures)
+         associate (structure => scene%structures(s))
+            if (structure%motion%kind /= motion_table) cycle
+            call shape_bounds(structure_shape(structure, scene%grid%dim), scene%grid%dim, lower, upper)
+            call load_motion_table(scene%source_file, scene%grid, group_context(label, 'structure', s, &
+                                   named(structure%name)), 'structure', lower, upper, structure%motion, &
+                                   scene%structure_tables(s), status)
          end associate
+         if (.not. status%ok) return
       end do
-   end subroutine load_wall_tables
+   end subroutine load_motion_tables
 
-   !> "name 'paddle'" (every wall has a name once the scene is resolved; '' before).
-   pure function wall_detail(name) result(detail)
+   !> The table of one motion (load_motion_tables) of a scene read from `source_file` with the scene box
+   !> of `grid`: `context` the group's, `what` 'wall' (its point lower = upper) or 'structure' (its world
+   !> bounding box lower..upper at rest).
+   subroutine load_motion_table(source_file, grid, context, what, lower, upper, spec, table, status)
+      character(len=*), intent(in) :: source_file
+      type(grid_spec_t), intent(in) :: grid
+      character(len=*), intent(in) :: context, what
+      real(rp), intent(in) :: lower(3), upper(3)
+      type(motion_spec_t), intent(inout) :: spec
+      type(time_table_t), intent(out) :: table
+      type(status_t), intent(inout) :: status
+      character(len=*), parameter :: axes(3) = ['x', 'y', 'z']
+      character(len=:), allocatable :: where, reach
+      character(len=1024) :: message
+      real(rp) :: box_lower(3), box_upper(3), tolerance, low, high
+      integer :: dim, r, k
+
+      dim = grid%dim
+      tolerance = 1.0e-9_rp * grid%cell_size
+      box_lower = grid%origin
+      box_upper = grid%origin + grid%extent
+      where = context//": variable motion_file = '"//trim(spec%file)//"'"
+      call read_time_table(beside(source_file, trim(spec%file)), axes(1:dim), table, message)
+      if (len_trim(message) > 0) then
+         call status%fail(where//': '//trim(message))
+         return
+      end if
+      if (len_trim(spec%checksum) > 0 .and. trim(spec%checksum) /= table%checksum) then
+         call status%fail(where//': '//trim(table%path)//": the table does not match motion_checksum = '"// &
+                          trim(spec%checksum)//"' (the file gives '"//table%checksum// &
+                          "'): the file changed since the scene was written")
+         return
+      end if
+      ! the motion is rigid: the point (the shape's box) stays in the scene box at every row, linear in between
+      do r = 1, size(table%time)
+         do k = 1, dim
+            low = lower(k) + table%values(k, r)
+            high = upper(k) + table%values(k, r)
+            if (low < box_lower(k) - tolerance .or. high > box_upper(k) + tolerance) then
+               if (what == 'wall') then
+                  reach = 'its point('//int_text(k)//') reaches '//real_text(low)
+               else
+                  reach = 'it spans '//axes(k)//' = '//real_text(low)//' .. '//real_text(high)
+               end if
+               call status%fail(where//': the motion drives the '//what//' out of the scene box of &grid: at t = '// &
+                                real_text(table%time(r))//' s '//reach//', the box is '//real_text(box_lower(k))// &
+                                ' .. '//real_text(box_upper(k)))
+               return
+            end if
+         end do
+      end do
+      if (len_trim(table%path) > path_len) then
+         call status%fail(where//': the path is longer than '//int_text(path_len)//' characters')
+         return
+      end if
+      spec%file = table%path
+      spec%checksum = table%checksum
+   end subroutine load_motion_table
+
+   !> "name 'paddle'" (every wall and structure has a name once the scene is resolved; '' before).
+   pure function named(name) result(detail)
       character(len=*), intent(in) :: name
       character(len=:), allocatable :: detail
       detail = ''
       if (len_trim(name) > 0) detail = "name '"//trim(name)//"'"
-   end function wall_detail
+   end function named
 
    !> X(theta) = (A / (k h)) (tanh theta + tanh theta_0).
    pure real(rp) function paddle_position(self, theta) result(x)

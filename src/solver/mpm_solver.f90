@@ -234,7 +234,12 @@ contains
       ! loads.csv entries before the structures: the &wall groups, the box sides, the inlets
       entries = size(box_side_walls(self%scene%grid)) + size(self%inlets)
       if (allocated(self%scene%walls)) entries = entries + size(self%scene%walls)
-      call build_structures(self%scene%structures, self%grid, entries, self%walls)
+      if (allocated(self%scene%structure_tables)) then
+         call build_structures(self%scene%structures, self%grid, entries, self%walls, self%scene%gravity, self%time, &
+                               self%scene%structure_tables)
+      else
+         call build_structures(self%scene%structures, self%grid, entries, self%walls, self%scene%gravity, self%time)
+      end if
    end subroutine build_boundaries
 
    !> A structure displaces the fluid: the particles of fluid bodies seeded inside it (phi < 0) are not
@@ -415,7 +420,7 @@ contains
       do i = 1, size(self%inlets)
          call self%inlets(i)%feed(self%walls, self%grid, self%time + dt)
       end do
-      ! moving walls: placed at t_n (node lists rebuilt), their velocity the mean over the step
+      ! moving walls and structures: placed at t_n (node lists rebuilt), their velocity the mean over the step
       call move_walls(self%walls, self%grid, self%time, self%time + dt)
       call self%loads%begin_step(size(self%walls))
       if (self%volume%shifting) then
@@ -491,7 +496,7 @@ contains
       end if
 
       call self%timers%switch_to(phase_walls)
-      ! the safeguard against the moving walls where they are at the step's end
+      ! the safeguard against the moving walls and structures where they are at the step's end
       call place_moving_walls(self%walls, self%grid, self%time + dt)
       if (self%contact%active) then
          call keep_particles_inside(self%walls, self%grid, self%particles, self%wall_corrections, self%loads%step_impulse, &

@@ -32,6 +32,7 @@ usage: check_moving_walls.py <flotsam> <mpiexec> <tests/runs/scenes> [<scripts f
 import argparse
 import math
 import os
+import re
 import sys
 import time
 
@@ -202,36 +203,38 @@ def interval_mean(t, values, start, end):
     return float(np.sum(values[inside] * widths[inside]) / np.sum(widths[inside]))
 
 
-def check_piston(checks, flotsam, scenes, ranks, figures):
-    """The piston of scenes/moving_walls/piston.nml: the mean force over 1-2 s against rho g h1^2 / 2."""
-    folder = os.path.join(scenes, "moving_walls")
-    flotsam.remove("piston")
-    path = flotsam.scene(os.path.join(folder, "piston.nml"), "piston.nml", "piston")
-    with open(os.path.join(folder, "piston.csv")) as source, open(flotsam.path("piston.csv"), "w") as copy:
+def check_piston(checks, flotsam, scenes, ranks, figures, folder="moving_walls", table="piston.csv", label="piston",
+                 gauge_x=0.3):
+    """The piston of scenes/<folder>/piston.nml (its motion file `table`, relative to that folder): the
+    mean force over 1-2 s against rho g h1^2 / 2, the level gauge `behind` at x = gauge_x."""
+    folder = os.path.join(scenes, folder)
+    flotsam.remove(label)
+    path = flotsam.scene(os.path.join(folder, "piston.nml"), label + ".nml", label)
+    with open(os.path.join(folder, table)) as source, open(flotsam.path("piston.csv"), "w") as copy:
         copy.write(source.read())
     start = time.time()
     process = flotsam.run(path, ranks, "--overwrite", timeout=3600)
     seconds = time.time() - start
-    if not checks.check(process.returncode == 0, f"piston: run on {ranks} ranks ({seconds:.0f} s)",
+    if not checks.check(process.returncode == 0, f"{label}: run on {ranks} ranks ({seconds:.0f} s)",
                         process.stderr[-2000:]):
         return
     u = 0.1
     h1, s = bore(u)
     exact = RHO * G * h1 ** 2 / 2.0
-    loads = pd.read_csv(flotsam.path("piston", "loads.csv"), comment="#")
+    loads = pd.read_csv(flotsam.path(label, "loads.csv"), comment="#")
     t = loads["time"].to_numpy()
     force = interval_mean(t, -loads["paddle_fx"].to_numpy(), 1.0, 2.0)
-    gauges = pd.read_csv(flotsam.path("piston", "gauges.csv"), comment="#")
+    gauges = pd.read_csv(flotsam.path(label, "gauges.csv"), comment="#")
     inside = (gauges["time"] > 1.0) & (gauges["time"] <= 2.0)
     depth = float(gauges["behind_level"][inside].mean())
     hydrostatic = RHO * G * H ** 2 / 2.0
     error = force / exact - 1.0
-    print(f"     piston U = {u} m/s: bore h1 = {h1:.6f} m (gauge at x = 0.3 m: {depth:.6f} m, "
+    print(f"     {label} U = {u} m/s: bore h1 = {h1:.6f} m (gauge at x = {gauge_x} m: {depth:.6f} m, "
           f"{depth / h1 - 1.0:+.2%}), s = {s:.5f} m/s; force over 1-2 s {force:.3f} N/m against rho g h1^2 / 2 = "
           f"rho g h^2 / 2 + rho h1 U s = {exact:.3f} N/m ({error:+.2%}); the part above the hydrostatic "
           f"{hydrostatic:.2f} N/m: {force - hydrostatic:.3f} against {exact - hydrostatic:.3f} N/m "
           f"({(force - hydrostatic) / (exact - hydrostatic) - 1.0:+.1%})", flush=True)
-    checks.check(abs(error) <= TOLERANCE["force"], "piston: force within 3 % of rho g h1^2 / 2", f"{error:+.2%}")
+    checks.check(abs(error) <= TOLERANCE["force"], f"{label}: force within 3 % of rho g h1^2 / 2", f"{error:+.2%}")
     if figures:
         import matplotlib
         matplotlib.use("Agg")
@@ -246,65 +249,94 @@ def check_piston(checks, flotsam, scenes, ranks, figures):
         axes.set_title("piston pushed at U = 0.1 m/s into water 0.1 m deep")
         axes.legend(fontsize=8)
         figure.tight_layout()
-        path = os.path.join(figures, "moving_walls_piston.png")
+        path = os.path.join(figures, f"moving_walls_{label}.png")
         figure.savefig(path, dpi=110)
         plt.close(figure)
         print(f"     figure: {path}", flush=True)
 
 
-def check_restart_and_ranks(checks, flotsam_path, mpiexec, scenes):
+def check_restart_and_ranks(checks, flotsam_path, mpiexec, scenes, folder="moving_walls", scene="piston.nml",
+                            tables=("piston.csv",), end_time=0.6, interval=300, stop=610, label="piston"):
     """The piston to t = 0.6 s on 2 ranks, checkpoints every 300 steps; again stopped at step 610 and
-    continued from the step-600 checkpoint: loads.csv and gauges.csv rows byte for byte. And the same on 1
-    rank: loads within 1e-10 relative (of the largest force)."""
+    continued from the step-600 checkpoint: loads.csv and gauges.csv rows byte for byte; refused once the
+    table changed. And the same on 1 rank: loads within 1e-10 relative (of the largest force). Another
+    scene of scenes/<folder> likewise (`tables`: its motion files, relative to that folder;
+    check_moving_structures.py)."""
     import glob
     import h5py
-    folder = os.path.join(scenes, "moving_walls")
+    folder = os.path.join(scenes, folder)
+    checkpoint_step = stop // interval * interval
     runs = {}
-    for name, ranks, extra in (("full", 2, ""), ("split", 2, "\n   max_steps = 610"), ("one", 1, "")):
-        flotsam = Flotsam(flotsam_path, mpiexec, f"restart_{name}")
+    for name, ranks, extra in (("full", 2, ""), ("split", 2, f"\n   max_steps = {stop}"), ("one", 1, "")):
+        flotsam = Flotsam(flotsam_path, mpiexec, f"restart_{label}_{name}")
         flotsam.remove("out")
-        with open(os.path.join(folder, "piston.nml")) as f:
+        with open(os.path.join(folder, scene)) as f:
             text = f.read()
-        text = text.replace("output_dir = 'output/piston'", "output_dir = 'out'")
+        text = re.sub(r"output_dir\s*=\s*'[^']*'", "output_dir = 'out'", text)
         start = text.index("&run")
         end = text.index("\n/", start)
-        text = text[:end] + "\n   end_time = 0.6\n   checkpoint_interval_steps = 300" + extra + text[end:]
+        text = (text[:end] + f"\n   end_time = {end_time}\n   checkpoint_interval_steps = {interval}" + extra +
+                text[end:])
         with open(flotsam.path("scene.nml"), "w") as f:
             f.write(text)
-        with open(os.path.join(folder, "piston.csv")) as source, open(flotsam.path("piston.csv"), "w") as copy:
-            copy.write(source.read())
+        for table in tables:
+            with open(os.path.join(folder, table)) as source, \
+                    open(flotsam.path(os.path.basename(table)), "w") as copy:
+                copy.write(source.read())
         result = flotsam.run("scene.nml", ranks)
-        if not checks.check(result.returncode == 0, f"restart: the {name} run on {ranks} ranks", result.stderr[-2000:]):
+        if not checks.check(result.returncode == 0, f"{label} restart: the {name} run on {ranks} ranks",
+                            result.stderr[-2000:]):
             return
         runs[name] = flotsam
     split = runs["split"]
     checkpoint = None
     for path in sorted(glob.glob(split.path("out", "checkpoints", "checkpoint_*.h5"))):
         with h5py.File(path) as f:
-            if int(f.attrs["step"]) == 600:
+            if int(f.attrs["step"]) == checkpoint_step:
                 checkpoint = os.path.relpath(path, split.workdir)
-    if not checks.check(checkpoint is not None, "restart: a checkpoint at step 600"):
+    if not checks.check(checkpoint is not None, f"{label} restart: a checkpoint at step {checkpoint_step}"):
         return
     with open(split.path("scene.nml")) as f:
-        text = f.read().replace("\n   max_steps = 610", "")
+        text = f.read().replace(f"\n   max_steps = {stop}", "")
     with open(split.path("continue.nml"), "w") as f:
         f.write(text)
     result = split.run("continue.nml", 2, "--restart", checkpoint)
-    checks.check(result.returncode == 0, "restart: continued from step 600", result.stderr[-2000:])
+    checks.check(result.returncode == 0, f"{label} restart: continued from step {checkpoint_step}",
+                 result.stderr[-2000:])
     for file in ("loads", "gauges"):
+        if not os.path.exists(runs["full"].path("out", file + ".csv")):
+            continue
         rows = {}
         for name in ("full", "split"):
             with open(runs[name].path("out", file + ".csv")) as f:
                 rows[name] = [line for line in f.read().splitlines() if not line.startswith("#")]
         checks.check(rows["full"] == rows["split"] and len(rows["full"]) > 10,
-                     f"restart: {file}.csv rows byte for byte ({len(rows['full'])} lines)",
+                     f"{label} restart: {file}.csv rows byte for byte ({len(rows['full'])} lines)",
                      f"{len(rows['split'])} lines against {len(rows['full'])}")
+    # the table changes (a row appended that holds the last place a second longer: the same motion, other
+    # numbers): a restart from the newest checkpoint (the continuation removed the older ones) is refused
+    checkpoint = os.path.relpath(sorted(glob.glob(split.path("out", "checkpoints", "checkpoint_*.h5")))[-1],
+                                 split.workdir)
+    table = split.path(os.path.basename(tables[0]))
+    with open(table) as f:
+        original = f.read()
+    last = [line for line in original.splitlines() if line.strip() and not line.startswith(("#", "t"))][-1]
+    values = last.split(",")
+    with open(table, "w") as f:
+        f.write(original.rstrip("\n") + "\n" + ",".join([repr(float(values[0]) + 1.0)] + values[1:]) + "\n")
+    result = split.run("continue.nml", 2, "--restart", checkpoint)
+    with open(table, "w") as f:
+        f.write(original)
+    errors = [line for line in result.stderr.splitlines() if "flotsam: error:" in line]
+    checks.check(result.returncode == 2 and len(errors) == 1 and "motion_checksum" in errors[0],
+                 f"{label} restart: refused after the table changed (exit 2, one line naming motion_checksum)",
+                 f"exit {result.returncode}: {errors}")
     two = pd.read_csv(runs["full"].path("out", "loads.csv"), comment="#")
     one = pd.read_csv(runs["one"].path("out", "loads.csv"), comment="#")
     scale = float(np.abs(two.drop(columns="time").to_numpy()).max())
     deviation = float(np.abs(two.drop(columns="time").to_numpy() - one.drop(columns="time").to_numpy()).max())
-    checks.check(deviation <= 1e-10 * scale, f"ranks: loads.csv on 1 and 2 ranks agree to {deviation / scale:.1e} "
-                 "of the largest force", f"{deviation / scale:.2e}")
+    checks.check(deviation <= 1e-10 * scale, f"{label} ranks: loads.csv on 1 and 2 ranks agree to "
+                 f"{deviation / scale:.1e} of the largest force", f"{deviation / scale:.2e}")
 
 
 def main():
