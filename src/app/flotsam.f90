@@ -15,6 +15,7 @@ program flotsam
    use error_status, only: status_t
    use scene_description, only: scene_t
    use scene_reader, only: read_scene, scene_override_t
+   use scene_validation, only: scene_advice
    use output_directory, only: prepare_output_directory, prepare_restart_directory
    use mpm_solver, only: solver_t
    use run_progress, only: run_progress_t
@@ -55,6 +56,7 @@ program flotsam
       call write_scene_file(scene, MPI_COMM_WORLD, solver%domain%nranks, status)     ! <output_dir>/scene.nml
       if (.not. status%ok) call fail(status, exit_output_folder)
       call print_banner()
+      call print_advice()
    else
       call solver%init(scene, MPI_COMM_WORLD, status, seed_particles=.false.)
       if (.not. status%ok) call fail(status, exit_scene)
@@ -66,6 +68,7 @@ program flotsam
       call write_scene_file(scene, MPI_COMM_WORLD, solver%domain%nranks, status, restart_path, solver%step)
       if (.not. status%ok) call fail(status, exit_scene)
       call print_banner()
+      call print_advice()
       if (rank == 0 .and. len(scene_warning) > 0) write (error_unit, '(a)') 'flotsam: warning: '//scene_warning
       if (rank == 0) write (error_unit, '(a,i0,a)') 'flotsam: continuing '//restart_path//' from step ', &
          solver%step, ' (t = '//real_text(solver%time)//' s)'
@@ -269,6 +272,13 @@ contains
          ': scene '//scene_path//changes//', output folder '//trim(scene%run%output_dir)
       flush (error_unit)
    end subroutine print_banner
+
+   !> A valid scene likely to fail (scene_advice): one warning line from rank 0; the run goes on.
+   subroutine print_advice()
+      character(len=:), allocatable :: advice
+      advice = scene_advice(scene)
+      if (rank == 0 .and. len(advice) > 0) write (error_unit, '(a)') 'flotsam: warning: '//advice
+   end subroutine print_advice
 
    !> Every rank holds the same failed status: rank 0 reports it, all ranks exit with `code`.
    subroutine fail(failed, code)

@@ -24,7 +24,7 @@ module scene_validation
    private
 
    public :: validate_scene, resolve_scene, find_material, find_structure, default_name, side_name
-   public :: check_scene_memory, scene_particle_count, memory_estimate_per_rank
+   public :: check_scene_memory, scene_particle_count, memory_estimate_per_rank, scene_advice
 
    !> Peak resident memory per particle a run grows by [bytes]: particle arrays, sort buffers and the
    !> fields file's buffers, measured as the slope of run_summary.csv's peak_memory_bytes over the
@@ -244,6 +244,20 @@ contains
    end function memory_estimate_per_rank
 
    !> Bodies that get a velocity field of their own: those of a material some `&contact` names.
+   !> Advice on a valid scene that is likely to fail, '' when there is none: the run prints it as a warning
+   !> after its banner. APIC on the multilinear grid with a fluid: its small-mass node where a free surface
+   !> rises through a row of nodes blows up at any step (docs/theory.md, "APIC" and section 3.6).
+   function scene_advice(scene) result(text)
+      type(scene_t), intent(in) :: scene
+      character(len=:), allocatable :: text
+      text = ''
+      if (scene%run%transfer /= 'apic' .or. scene%grid%shape_function /= 'linear') return
+      if (.not. any(scene%materials%model == model_newtonian_fluid)) return
+      text = "&run transfer = 'apic' with &grid shape_function = 'linear' and a fluid: APIC blows up where a free "// &
+             "surface rises through a row of nodes (waves, bores, moving walls); shape_function = 'bspline2' runs "// &
+             "them (docs/theory.md, APIC)"
+   end function scene_advice
+
    pure integer function contact_field_count(scene) result(fields)
       type(scene_t), intent(in) :: scene
       integer :: b, c

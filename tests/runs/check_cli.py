@@ -4,6 +4,7 @@
   * a run starts with a banner (version, commit, ranks, scene, output folder) and ends with one line
     (outcome, steps, simulated time, wall time, particle-steps/s); max_steps is named as the outcome
   * output times are k x output_interval: diagnostics.csv of output_interval = 0.1 reads 0.1, 0.2, 0.3
+  * linear APIC with a fluid gets one warning line after the banner (docs/theory.md, APIC); B-splines none
   * two whole scenes (`flotsam a.nml b.nml`) are refused with a usage hint
   * scenes too large for the machine are refused before any particle is made, on every rank: the dam
     break at 100 particles per cell under `ulimit -v` (2 GB per process), at 20000 without a limit
@@ -87,6 +88,23 @@ def main():
                  "max_steps run: the final line names max_steps", last)
     with open(flotsam.path("capped", "run_summary.csv")) as f:
         checks.check(f.read().strip().endswith(",max_steps"), "max_steps run: run_summary.csv outcome max_steps")
+
+    # advice on a valid scene likely to fail: linear APIC with a fluid warns once (rank 0), after the banner;
+    # the same on B-splines does not
+    for shape, expected in (("linear", 1), ("bspline2", 0)):
+        folder = f"apic_{shape}"
+        flotsam.remove(folder)
+        result = flotsam.run(dam_break, RANKS, "--set", f"&run transfer = 'apic', max_steps = 2, output_dir = '{folder}' /",
+                             "--set", f"&grid shape_function = '{shape}' /")
+        warnings = [line for line in result.stderr.splitlines() if line.startswith("flotsam: warning: ")]
+        advice = [line for line in warnings if "transfer = 'apic' with &grid shape_function = 'linear' and a fluid" in line
+                  and "shape_function = 'bspline2' runs them" in line]
+        checks.check(result.returncode == 0 and len(warnings) == expected and len(advice) == expected,
+                     f"APIC on {shape} shape functions with water: {expected} warning line(s), the run goes on",
+                     result.stderr[-1200:])
+        if expected:
+            checks.check(result.stderr.splitlines()[0].startswith("flotsam ") and result.stderr.splitlines()[1] == advice[0],
+                         "the warning follows the banner", result.stderr[:600])
 
     # two whole scenes
     flotsam.remove("column")
