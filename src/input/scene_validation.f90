@@ -19,7 +19,7 @@ module scene_validation
                              max_vertices, no_vertex, shape_box, shape_circle, shape_sphere, shape_cylinder, &
                              shape_polygon, shape_extruded_polygon
    use body_lattice, only: has_points_file, box_corners_given, body_shape, body_bounds, count_particles, particle_spacing
-   use wall_motion, only: wall_motion_t, prescribed_motion
+   use wall_motion, only: wall_motion_t, prescribed_motion, box_excursion
    implicit none
    private
 
@@ -243,7 +243,6 @@ contains
                real(bytes_per_node(dim) + contact_field_count(scene) * bytes_per_field_node(dim), rp) * nodes) / ranks
    end function memory_estimate_per_rank
 
-   !> Bodies that get a velocity field of their own: those of a material some `&contact` names.
    !> Advice on a valid scene that is likely to fail, '' when there is none: the run prints it as a warning
    !> after its banner. APIC on the multilinear grid with a fluid: its small-mass node where a free surface
    !> rises through a row of nodes blows up at any step (docs/theory.md, "APIC" and section 3.6).
@@ -258,6 +257,7 @@ contains
              "them (docs/theory.md, APIC)"
    end function scene_advice
 
+   !> Bodies that get a velocity field of their own: those of a material some `&contact` names.
    pure integer function contact_field_count(scene) result(fields)
       type(scene_t), intent(in) :: scene
       integer :: b, c
@@ -1179,9 +1179,9 @@ contains
       type(scene_t), intent(in) :: scene
       type(status_t), intent(inout) :: status
       type(wall_motion_t) :: motion
-      real(rp) :: g, low(3), high(3), box_lower(3), box_upper(3), tolerance
+      real(rp) :: g
       integer :: k, dim
-      character(len=:), allocatable :: reach
+      character(len=:), allocatable :: excursion
       if (.not. status%ok) return
       dim = scene%grid%dim
       if (all(spec%kind /= motion_keywords)) then
@@ -1223,30 +1223,11 @@ contains
                              "' (the direction of the stroke, not zero)")
       end if
       if (.not. status%ok) return
-      if (what == 'structure') then
-         motion = prescribed_motion(spec, spec%direction, scene%gravity, dim)
-      else
-         motion = prescribed_motion(spec, direction, scene%gravity, dim)
-      end if
+      motion = prescribed_motion(spec, direction, scene%gravity, dim)
       ! the stroke is monotonic along its direction: its end is the farthest place
-      low = lower + motion%stroke() * motion%direction
-      high = upper + motion%stroke() * motion%direction
-      box_lower = scene%grid%origin
-      box_upper = scene%grid%origin + scene%grid%extent
-      tolerance = 1.0e-9_rp * scene%grid%cell_size
-      do k = 1, dim
-         if (low(k) < box_lower(k) - tolerance .or. high(k) > box_upper(k) + tolerance) then
-            if (what == 'wall') then
-               reach = 'its point('//int_text(k)//') reaches '//real_text(low(k))
-            else
-               reach = 'it spans '//axis_letter(k)//' = '//real_text(low(k))//' .. '//real_text(high(k))
-            end if
-            call status%fail(where//": variable motion = '"//trim(spec%kind)//"' drives the "//what//' out of the '// &
-                             'scene box of &grid: '//reach//', the box is '//real_text(box_lower(k))//' .. '// &
-                             real_text(box_upper(k)))
-            return
-         end if
-      end do
+      excursion = box_excursion(scene%grid, what, lower, upper, motion%stroke() * motion%direction(1:dim))
+      if (len(excursion) > 0) call status%fail(where//": variable motion = '"//trim(spec%kind)//"' drives the "// &
+                                               what//' out of the scene box of &grid: '//excursion)
 
    contains
 

@@ -56,7 +56,7 @@ module wall_motion
       procedure :: end_time => motion_end_time
    end type wall_motion_t
 
-   public :: solitary_motion, prescribed_motion, load_motion_tables
+   public :: solitary_motion, prescribed_motion, load_motion_tables, box_excursion
 
 contains
 
@@ -219,15 +219,11 @@ contains
       type(time_table_t), intent(out) :: table
       type(status_t), intent(inout) :: status
       character(len=*), parameter :: axes(3) = ['x', 'y', 'z']
-      character(len=:), allocatable :: where, reach
+      character(len=:), allocatable :: where, excursion
       character(len=1024) :: message
-      real(rp) :: box_lower(3), box_upper(3), tolerance, low, high
-      integer :: dim, r, k
+      integer :: dim, r
 
       dim = grid%dim
-      tolerance = 1.0e-9_rp * grid%cell_size
-      box_lower = grid%origin
-      box_upper = grid%origin + grid%extent
       where = context//": variable motion_file = '"//trim(spec%file)//"'"
       call read_time_table(beside(source_file, trim(spec%file)), axes(1:dim), table, message)
       if (len_trim(message) > 0) then
@@ -242,21 +238,12 @@ contains
       end if
       ! the motion is rigid: the point (the shape's box) stays in the scene box at every row, linear in between
       do r = 1, size(table%time)
-         do k = 1, dim
-            low = lower(k) + table%values(k, r)
-            high = upper(k) + table%values(k, r)
-            if (low < box_lower(k) - tolerance .or. high > box_upper(k) + tolerance) then
-               if (what == 'wall') then
-                  reach = 'its point('//int_text(k)//') reaches '//real_text(low)
-               else
-                  reach = 'it spans '//axes(k)//' = '//real_text(low)//' .. '//real_text(high)
-               end if
-               call status%fail(where//': the motion drives the '//what//' out of the scene box of &grid: at t = '// &
-                                real_text(table%time(r))//' s '//reach//', the box is '//real_text(box_lower(k))// &
-                                ' .. '//real_text(box_upper(k)))
-               return
-            end if
-         end do
+         excursion = box_excursion(grid, what, lower, upper, table%values(1:dim, r))
+         if (len(excursion) > 0) then
+            call status%fail(where//': the motion drives the '//what//' out of the scene box of &grid: at t = '// &
+                             real_text(table%time(r))//' s '//excursion)
+            return
+         end if
       end do
       if (len_trim(table%path) > path_len) then
          call status%fail(where//': the path is longer than '//int_text(path_len)//' characters')
@@ -265,6 +252,35 @@ contains
       spec%file = table%path
       spec%checksum = table%checksum
    end subroutine load_motion_table
+
+   !> Where a wall's point (`what` = 'wall', lower = upper) or a structure's world box lower..upper (at
+   !> rest), moved by the displacement d(1:dim), leaves the scene box of `grid`: "its point(k) reaches v, the
+   !> box is a .. b" or "it spans x = v .. w, the box is a .. b" for the first axis out; '' when inside.
+   function box_excursion(grid, what, lower, upper, d) result(text)
+      type(grid_spec_t), intent(in) :: grid
+      character(len=*), intent(in) :: what
+      real(rp), intent(in) :: lower(3), upper(3), d(:)
+      character(len=:), allocatable :: text
+      character(len=*), parameter :: axes(3) = ['x', 'y', 'z']
+      real(rp) :: tolerance, low, high, box_lower, box_upper
+      integer :: k
+      text = ''
+      tolerance = 1.0e-9_rp * grid%cell_size
+      do k = 1, grid%dim
+         low = lower(k) + d(k)
+         high = upper(k) + d(k)
+         box_lower = grid%origin(k)
+         box_upper = grid%origin(k) + grid%extent(k)
+         if (low >= box_lower - tolerance .and. high <= box_upper + tolerance) cycle
+         if (what == 'wall') then
+            text = 'its point('//int_text(k)//') reaches '//real_text(low)
+         else
+            text = 'it spans '//axes(k)//' = '//real_text(low)//' .. '//real_text(high)
+         end if
+         text = text//', the box is '//real_text(box_lower)//' .. '//real_text(box_upper)
+         return
+      end do
+   end function box_excursion
 
    !> "name 'paddle'" (every wall and structure has a name once the scene is resolved; '' before).
    pure function named(name) result(detail)
