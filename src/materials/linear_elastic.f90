@@ -32,8 +32,8 @@ contains
       class(linear_elastic_t), intent(in) :: self
       integer, intent(in) :: dim
       real(rp), intent(in) :: dt
-      real(rp), intent(in) :: strain_rate(:, :), spin(:, :)
-      real(rp), intent(inout) :: density(:), sbar(:, :)
+      real(rp), intent(in), contiguous :: strain_rate(:, :), spin(:, :)
+      real(rp), intent(inout), contiguous :: density(:), sbar(:, :)
       integer :: p
       do p = 1, size(density)
          call elastic_point_update(self%lame_lambda, self%shear_modulus, dim, dt, strain_rate(:, p), spin(:, p), &

@@ -25,8 +25,8 @@ module material_model
          class(material_model_t), intent(in) :: self
          integer, intent(in) :: dim
          real(rp), intent(in) :: dt
-         real(rp), intent(in) :: strain_rate(:, :), spin(:, :)
-         real(rp), intent(inout) :: density(:), sbar(:, :)
+         real(rp), intent(in), contiguous :: strain_rate(:, :), spin(:, :)
+         real(rp), intent(inout), contiguous :: density(:), sbar(:, :)
       end subroutine update_stress_interface
 
       !> Speed of the fastest wave at the given density [m/s] (time step, algorithms.md section 5.4).

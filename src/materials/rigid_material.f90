@@ -23,8 +23,8 @@ contains
       class(rigid_material_t), intent(in) :: self
       integer, intent(in) :: dim
       real(rp), intent(in) :: dt
-      real(rp), intent(in) :: strain_rate(:, :), spin(:, :)
-      real(rp), intent(inout) :: density(:), sbar(:, :)
+      real(rp), intent(in), contiguous :: strain_rate(:, :), spin(:, :)
+      real(rp), intent(inout), contiguous :: density(:), sbar(:, :)
       ! the interface's arguments are not needed: the particles keep their density and no stress
       if (dim < 0 .or. dt < 0.0_rp .or. size(strain_rate) < 0 .or. size(spin) < 0 .or. size(density) < 0) return
       if (size(sbar) > 0 .or. self%reference_density < 0.0_rp) sbar = 0.0_rp

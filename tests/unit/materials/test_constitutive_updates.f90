@@ -8,7 +8,8 @@ module test_constitutive_updates
    implicit none
    private
 
-   public :: test_fluid_pressure_increment, test_fluid_viscous_stress, test_inviscid_update_bitwise, test_elastic_uniaxial_strain, &
+   public :: test_fluid_pressure_increment, test_fluid_viscous_stress, test_inviscid_update_bitwise, test_viscous_update_bitwise, &
+             test_elastic_uniaxial_strain, &
              test_elastic_uniaxial_stress_nu0, test_jaumann_hydrostatic_invariance, test_jaumann_rotation_rate
 
 contains
@@ -58,17 +59,38 @@ contains
       d(:, 3) = [0.2_rp, -0.2_rp, 0.0_rp, 0.7_rp]           ! tr d = 0
       sbar = 0.0_rp
       sbar(1:3, 1) = -30.0_rp
-      call check_inviscid_slice(2, d, sbar, '2-D')
+      call check_slice(2, 0.0_rp, d, sbar, '2-D')
       d3(:, 1) = [0.2_rp, -0.1_rp, 0.4_rp, -0.01_rp, 0.0_rp, 0.03_rp]
       d3(:, 2) = [0.1_rp, -0.1_rp, 0.0_rp, -0.0_rp, 0.0_rp, -0.03_rp]
       sbar3 = 0.0_rp
-      call check_inviscid_slice(3, d3, sbar3, '3-D')
+      call check_slice(3, 0.0_rp, d3, sbar3, '3-D')
    end subroutine test_inviscid_update_bitwise
 
-   !> The slice update of an inviscid fluid against fluid_point_update with mu = 0, bit for bit.
-   subroutine check_inviscid_slice(dim, d, sbar, label)
+   !> A viscous fluid's slice update, its components written out so that the compiler vectorises it,
+   !> must give the bits of the point update, in 2-D and 3-D, over 13 particles (a vector loop and its
+   !> remainder), compressed and stretched, with shear of both signs.
+   subroutine test_viscous_update_bitwise()
+      integer, parameter :: n = 13
+      real(rp) :: d(4, n), sbar(4, n), d3(6, n), sbar3(6, n)
+      integer :: p, k
+      do p = 1, n
+         do k = 1, 6
+            d3(k, p) = 0.3_rp * sin(1.7_rp * p + 0.9_rp * k)
+            sbar3(k, p) = merge(-30.0_rp + p, 0.4_rp * cos(1.1_rp * p * k), k <= 3)
+         end do
+      end do
+      d = d3([1, 2, 3, 6], :)
+      d(3, :) = 0.0_rp                                       ! plane strain
+      sbar = sbar3([1, 2, 3, 6], :)
+      call check_slice(2, 1.0e-3_rp, d, sbar, '2-D viscous')
+      call check_slice(3, 1.0e-3_rp, d3, sbar3, '3-D viscous')
+   end subroutine test_viscous_update_bitwise
+
+   !> The slice update of a fluid against fluid_point_update, bit for bit (viscosity 0: the inviscid path).
+   subroutine check_slice(dim, viscosity, d, sbar, label)
       integer, intent(in) :: dim
-      real(rp), intent(in) :: d(:, :), sbar(:, :)
+      real(rp), intent(in) :: viscosity
+      real(rp), intent(in), contiguous :: d(:, :), sbar(:, :)
       character(len=*), intent(in) :: label
       real(rp), parameter :: dt = 1.0e-4_rp, k = 2.0e7_rp
       type(newtonian_fluid_t) :: fluid
@@ -76,7 +98,7 @@ contains
       real(rp) :: slice_density(size(d, 2)), point_density(size(d, 2))
       integer :: p, n
       fluid%bulk_modulus = k
-      fluid%viscosity = 0.0_rp
+      fluid%viscosity = viscosity
       spin = 0.0_rp
       n = size(d, 2)
       slice_density = 1000.0_rp - [(2.0_rp * p, p = 1, n)]
@@ -84,14 +106,14 @@ contains
       slice_sbar = sbar
       point_sbar = sbar
       do p = 1, n
-         call fluid_point_update(k, 0.0_rp, dim, dt, d(:, p), point_density(p), point_sbar(:, p))
+         call fluid_point_update(k, viscosity, dim, dt, d(:, p), point_density(p), point_sbar(:, p))
       end do
       call fluid%update_stress(dim, dt, d, spin, slice_density, slice_sbar)
       call assertTrue(all(transfer(slice_sbar, 0_i8, size(sbar)) == transfer(point_sbar, 0_i8, size(sbar))), &
                       label//' sbar bit for bit')
       call assertTrue(all(transfer(slice_density, 0_i8, n) == transfer(point_density, 0_i8, n)), &
                       label//' density bit for bit')
-   end subroutine check_inviscid_slice
+   end subroutine check_slice
 
    !> Uniaxial strain in 3-D: sigma_xx = (lambda + 2 G) eps, sigma_yy = sigma_zz = lambda eps.
    subroutine test_elastic_uniaxial_strain()
