@@ -14,7 +14,7 @@ module mpm_solver
    use kinds, only: rp, i8
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_Allgather, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_MIN, &
                       MPI_INTEGER8
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
    use error_status, only: status_t
    use communication_counters, only: count_collective, comm_time_step, comm_balance, comm_other, real_bytes, int8_bytes
    use scene_description, only: scene_t, run_control_t, wall_spec_t, model_newtonian_fluid
@@ -623,8 +623,6 @@ contains
    !> MUSL: update the particle velocities, then nodal velocities from their momentum, with walls.
    subroutine remap_velocities(self)
       type(solver_t), intent(inout) :: self
-      integer :: i
-      real(rp) :: m
       if (self%contact%active) then
          call update_velocity_and_remap(self%grid, self%particles, self%run%flip_fraction, self%contact%remapped, &
                                         self%contact%particle_field, self%contact%velocity, self%contact%increment)
@@ -642,14 +640,7 @@ contains
       call self%timers%switch_to(phase_halo)
       call sum_shared_nodes(self%domain, self%grid, self%remapped_momentum)
       call self%timers%switch_to(phase_grid_to_particles)
-      do i = 1, self%grid%node_count
-         m = self%grid%accumulated(row_mass, i)
-         if (m > self%mass_tolerance) then
-            self%remapped_momentum(:, i) = self%remapped_momentum(:, i) / m
-         else
-            self%remapped_momentum(:, i) = 0.0_rp
-         end if
-      end do
+      call momenta_to_velocities(self%grid%accumulated, self%mass_tolerance, self%remapped_momentum)
       call self%timers%switch_to(phase_walls)
       call apply_wall_constraints(self%walls, self%grid%dim, self%remapped_momentum)
       call self%timers%switch_to(phase_grid_to_particles)
@@ -766,7 +757,7 @@ contains
    subroutine local_speeds(self, speeds)
       type(solver_t), intent(in) :: self
       real(rp), intent(out) :: speeds(:)
-      integer :: m, first, last, p
+      integer :: m, first, last
       real(rp) :: speed2, rho_min
       speeds = 0.0_rp
       do m = 1, size(self%materials)
@@ -776,19 +767,119 @@ contains
          if (self%run%fixed_dt > 0.0_rp) then
             speeds(2 * m) = sqrt(real(self%grid%dim, rp)) * maxval(abs(self%particles%v(:, first:last)))
          else
-            ! one pass over the particles for both (max and min are exact: the order does not matter); a NaN
-            ! density is passed over as minval does (the health check reports it)
-            speed2 = 0.0_rp
-            rho_min = huge(1.0_rp)
-            do p = first, last
-               speed2 = max(speed2, sum(self%particles%v(:, p)**2))
-               if (self%particles%density(p) < rho_min) rho_min = self%particles%density(p)
-            end do
+            call fastest_and_lightest(self%particles%v(:, first:last), self%particles%density(first:last), &
+                                      speed2, rho_min)
             speeds(2 * m - 1) = self%materials(m)%model%wave_speed(rho_min)
             speeds(2 * m) = sqrt(speed2)
          end if
       end do
    end subroutine local_speeds
+
+   !> momentum(:, i) / m_i at the nodes whose mass m_i = accumulated(row_mass, i) exceeds `tolerance`, 0
+   !> elsewhere (MUSL's re-mapped velocities). Per dimension without inner loops, so that it vectorises.
+   pure subroutine momenta_to_velocities(accumulated, tolerance, momentum)
+      real(rp), intent(in), contiguous :: accumulated(:, :)
+      real(rp), intent(in) :: tolerance
+      real(rp), intent(inout), contiguous :: momentum(:, :)
+      if (size(momentum, 1) == 2) then
+         call divide_2d(size(accumulated, 1), size(momentum, 2), accumulated, momentum)
+      else
+         call divide_3d(size(accumulated, 1), size(momentum, 2), accumulated, momentum)
+      end if
+   contains
+      pure subroutine divide_2d(rows, n, accumulated, momentum)
+         integer, intent(in) :: rows, n
+         real(rp), intent(in) :: accumulated(rows, n)
+         real(rp), intent(inout) :: momentum(2, n)
+         integer :: i
+         do i = 1, n
+            if (accumulated(row_mass, i) > tolerance) then
+               momentum(1, i) = momentum(1, i) / accumulated(row_mass, i)
+               momentum(2, i) = momentum(2, i) / accumulated(row_mass, i)
+            else
+               momentum(1, i) = 0.0_rp
+               momentum(2, i) = 0.0_rp
+            end if
+         end do
+      end subroutine divide_2d
+      pure subroutine divide_3d(rows, n, accumulated, momentum)
+         integer, intent(in) :: rows, n
+         real(rp), intent(in) :: accumulated(rows, n)
+         real(rp), intent(inout) :: momentum(3, n)
+         integer :: i
+         do i = 1, n
+            if (accumulated(row_mass, i) > tolerance) then
+               momentum(1, i) = momentum(1, i) / accumulated(row_mass, i)
+               momentum(2, i) = momentum(2, i) / accumulated(row_mass, i)
+               momentum(3, i) = momentum(3, i) / accumulated(row_mass, i)
+            else
+               momentum(1, i) = 0.0_rp
+               momentum(2, i) = 0.0_rp
+               momentum(3, i) = 0.0_rp
+            end if
+         end do
+      end subroutine divide_3d
+   end subroutine momenta_to_velocities
+
+   !> The largest |v_p|^2 and the lowest density of a slice of particles (local_speeds) in one pass, which
+   !> the compiler vectorises (it was 4 % of a 2-D step as a scalar loop): per dimension, the velocities of
+   !> a known leading dimension, without inner loops, and NaNs counted in an integer (max and min are exact,
+   !> so the order does not matter). |v|^2 is summed from 0 as sum() does, so that the compiler fuses the
+   !> same multiplications into its additions and the step is the same bit for bit (v1^2 + v2^2 fused the
+   !> other one). A NaN density (the health check reports it) is passed over as minval
+   !> does: a vectorised min need not pass it over, so then a scalar pass.
+   pure subroutine fastest_and_lightest(v, density, speed2, rho_min)
+      real(rp), intent(in), contiguous :: v(:, :), density(:)
+      real(rp), intent(out) :: speed2, rho_min
+      integer :: n, p, nans
+      n = size(density)
+      speed2 = 0.0_rp
+      rho_min = huge(1.0_rp)
+      nans = 0
+      if (size(v, 1) == 2) then
+         call pass_2d(v, speed2, rho_min, nans)
+      else
+         call pass_3d(v, speed2, rho_min, nans)
+      end if
+      if (nans > 0) then
+         rho_min = huge(1.0_rp)
+         do p = 1, n
+            if (density(p) < rho_min) rho_min = density(p)
+         end do
+      end if
+   contains
+      pure subroutine pass_2d(v, speed2, rho_min, nans)
+         real(rp), intent(in) :: v(2, n)
+         real(rp), intent(inout) :: speed2, rho_min
+         integer, intent(inout) :: nans
+         real(rp) :: v2
+         integer :: p
+         do p = 1, n
+            v2 = 0.0_rp
+            v2 = v2 + v(1, p)**2
+            v2 = v2 + v(2, p)**2
+            speed2 = max(speed2, v2)
+            rho_min = min(rho_min, density(p))
+            nans = nans + merge(1, 0, ieee_is_nan(density(p)))
+         end do
+      end subroutine pass_2d
+      pure subroutine pass_3d(v, speed2, rho_min, nans)
+         real(rp), intent(in) :: v(3, n)
+         real(rp), intent(inout) :: speed2, rho_min
+         integer, intent(inout) :: nans
+         real(rp) :: v2
+         integer :: p
+         do p = 1, n
+            v2 = 0.0_rp
+            v2 = v2 + v(1, p)**2
+            v2 = v2 + v(2, p)**2
+            v2 = v2 + v(3, p)**2
+            speed2 = max(speed2, v2)
+            rho_min = min(rho_min, density(p))
+            nans = nans + merge(1, 0, ieee_is_nan(density(p)))
+         end do
+      end subroutine pass_3d
+   end subroutine fastest_and_lightest
 
    !> The stable step `dt` from the speeds of all ranks (local_speeds, reduced), and a bound `speed`
    !> [m/s] on how fast the particles move: the largest signal speed c + |v| of the materials and open
