@@ -41,10 +41,7 @@ contains
       integer, parameter :: tag_data = 202
 
       ! cells of all particles; cell = 0 marks a particle outside this rank's box
-      n_outside = 0
-      do p = 1, particles%count
-         call locate_particle(p)
-      end do
+      call grid%owned_local_cells(particles%count, particles%x, particles%cell, n_outside)
 
       width = particles%record_size()
       arrived = 0
