@@ -147,9 +147,14 @@ contains
       real(rp), intent(in) :: cell_mass(:)
       real(rp), intent(inout) :: sums(n, *)
       integer :: i, c
+      real(rp) :: m, quotient(n)
+      ! the n divisions unconditional (by 1 where m_c = 0), the store conditional: so they become one vector
+      ! division (under the test they stayed n scalar ones, 5 % of a C0 step)
       do i = 1, occupied%count
          c = occupied%cells(i)
-         if (cell_mass(c) > 0.0_rp) sums(:, c) = sums(:, c) / cell_mass(c)
+         m = cell_mass(c)
+         quotient = sums(:, c) / merge(m, 1.0_rp, m > 0.0_rp)
+         if (m > 0.0_rp) sums(:, c) = quotient
       end do
    end subroutine divide_by_cell_mass
 
@@ -259,6 +264,9 @@ contains
       real(rp), intent(in) :: cell_values(n, *)
       real(rp), intent(inout) :: values(n, *)
       integer :: i
+      ! one particle's n values in one vector load and store: vectorised over the particles instead, with
+      ! gathers of 8 values and permutations, the loop took 7 % of a C0 step
+      !GCC$ novector
       do i = 1, size(cell)
          values(:, i) = cell_values(:, cell(i))
       end do
