@@ -668,11 +668,15 @@ contains
    !> field) the mu a structure applies to that field instead of its condition (< 0: its condition), and
    !> field_impulse(:, w, f) gains the part of impulse(:, w) given to field f's particles. The particles of a
    !> material with `skip(material)` are left alone: rigid bodies meet walls as bodies (rigid_bodies).
-   subroutine keep_particles_inside(walls, grid, particles, corrections, impulse, field, field_friction, field_impulse, &
-                                    skip)
+   !> lowest(1:dim), highest(1:dim): bounds on the particles' coordinates (the step's extent, which G2P
+   !> takes as it moves them; wider is fine). They only let a wall's pass be skipped when no particle can
+   !> be behind it; a pass of their own over the particles was 3 % of a 2-D step.
+   subroutine keep_particles_inside(walls, grid, particles, lowest, highest, corrections, impulse, field, field_friction, &
+                                    field_impulse, skip)
       type(wall_t), intent(in) :: walls(:)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
+      real(rp), intent(in) :: lowest(:), highest(:)
       integer, intent(inout) :: corrections
       real(rp), intent(inout) :: impulse(:, :)
       integer, intent(in), optional :: field(:)
@@ -680,7 +684,7 @@ contains
       real(rp), intent(inout), optional :: field_impulse(:, :, :)
       logical, intent(in), optional :: skip(:)
       integer :: w, p, d
-      real(rp) :: distance, vn, lowest(3), highest(3), before(particles%dim)
+      real(rp) :: distance, vn, before(particles%dim)
       logical, allocatable :: skipped(:)
       d = particles%dim
       if (.not. any(walls%active)) return
@@ -690,7 +694,6 @@ contains
          allocate (skipped(max(1, maxval(particles%material(1:particles%count), 1))))
          skipped = .false.
       end if
-      call position_bounds(particles, lowest, highest)
       do w = 1, size(walls)
          if (.not. walls(w)%active) cycle
          if (walls(w)%shaped) then
@@ -830,57 +833,6 @@ contains
          end if
       end do
    end function first_particle_inside
-
-   !> Smallest and largest particle coordinate along each axis (one pass that vectorises; huge / -huge
-   !> without particles).
-   subroutine position_bounds(particles, lowest, highest)
-      type(particle_set_t), intent(in) :: particles
-      real(rp), intent(out) :: lowest(3), highest(3)
-      lowest = huge(1.0_rp)
-      highest = -huge(1.0_rp)
-      if (particles%dim == 2) then
-         call bounds_2d(particles%count, particles%x, lowest, highest)
-      else
-         call bounds_3d(particles%count, particles%x, lowest, highest)
-      end if
-   contains
-      ! per dimension, the positions of a known leading dimension and the bounds in scalars, so that the loop
-      ! vectorises (as a loop over the axes inside it, 3 % of a 2-D step); min and max are exact
-      pure subroutine bounds_2d(n, x, lowest, highest)
-         integer, intent(in) :: n
-         real(rp), intent(in) :: x(2, n)
-         real(rp), intent(inout) :: lowest(3), highest(3)
-         real(rp) :: lo1, lo2, hi1, hi2
-         integer :: p
-         lo1 = lowest(1); lo2 = lowest(2); hi1 = highest(1); hi2 = highest(2)
-         do p = 1, n
-            lo1 = min(lo1, x(1, p))
-            lo2 = min(lo2, x(2, p))
-            hi1 = max(hi1, x(1, p))
-            hi2 = max(hi2, x(2, p))
-         end do
-         lowest(1:2) = [lo1, lo2]
-         highest(1:2) = [hi1, hi2]
-      end subroutine bounds_2d
-      pure subroutine bounds_3d(n, x, lowest, highest)
-         integer, intent(in) :: n
-         real(rp), intent(in) :: x(3, n)
-         real(rp), intent(inout) :: lowest(3), highest(3)
-         real(rp) :: lo1, lo2, lo3, hi1, hi2, hi3
-         integer :: p
-         lo1 = lowest(1); lo2 = lowest(2); lo3 = lowest(3); hi1 = highest(1); hi2 = highest(2); hi3 = highest(3)
-         do p = 1, n
-            lo1 = min(lo1, x(1, p))
-            lo2 = min(lo2, x(2, p))
-            lo3 = min(lo3, x(3, p))
-            hi1 = max(hi1, x(1, p))
-            hi2 = max(hi2, x(2, p))
-            hi3 = max(hi3, x(3, p))
-         end do
-         lowest = [lo1, lo2, lo3]
-         highest = [hi1, hi2, hi3]
-      end subroutine bounds_3d
-   end subroutine position_bounds
 
    !> The safeguard of a moving wall (at its place at the step's end): a particle behind it goes back onto
    !> it and gets at least the wall's normal velocity, v - v_w losing its part into the wall (friction:

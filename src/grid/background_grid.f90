@@ -197,7 +197,9 @@ contains
       end do
    end function grid_cell_of_position
 
-   !> Global cell index along axis k of coordinate xk (rule of cell_of_position).
+   !> Global cell index along axis k of coordinate xk (rule of cell_of_position: the last face belongs to the
+   !> last cell). Without branches (integer flags), so that the loops calling it vectorise
+   !> (owned_local_cells).
    pure integer function grid_cell_along(self, xk, k) result(c)
       class(grid_t), intent(in) :: self
       real(rp), intent(in) :: xk
@@ -205,7 +207,7 @@ contains
       real(rp) :: s
       s = (xk - self%origin(k)) * self%inv_h
       c = floor(s)
-      if (c == self%global_cells(k) .and. s <= real(self%global_cells(k), rp) * (1 + epsilon(s))) c = c - 1
+      c = c - merge(1, 0, c == self%global_cells(k)) * merge(1, 0, s <= real(self%global_cells(k), rp) * (1 + epsilon(s)))
    end function grid_cell_along
 
    !> Local index of the owned cell holding x, or 0 if x lies outside the owned cells.
@@ -214,13 +216,10 @@ contains
       class(grid_t), intent(in) :: self
       real(rp), intent(in) :: x(:)
       integer :: k, c, stride
-      real(rp) :: s
       cell = 1
       stride = 1
       do k = 1, self%dim
-         s = (x(k) - self%origin(k)) * self%inv_h
-         c = floor(s)
-         if (c == self%global_cells(k) .and. s <= real(self%global_cells(k), rp) * (1 + epsilon(s))) c = c - 1
+         c = grid_cell_along(self, x(k), k)
          if (c < self%cell_lo(k) .or. c > self%cell_hi(k)) then
             cell = 0
             return
@@ -259,8 +258,8 @@ contains
          n1 = self%n_cells(1)
          missing = 0
          do p = 1, n
-            c1 = axis_cell(x(1, p), 1)
-            c2 = axis_cell(x(2, p), 2)
+            c1 = grid_cell_along(self, x(1, p), 1)
+            c2 = grid_cell_along(self, x(2, p), 2)
             inside = merge(1, 0, min(c1 - lo(1), hi(1) - c1, c2 - lo(2), hi(2) - c2) >= 0)
             cell(p) = inside * (1 + (c1 - lo(1)) + (c2 - lo(2)) * n1)
             missing = missing + (1 - inside)
@@ -278,25 +277,14 @@ contains
          n2 = self%n_cells(2)
          missing = 0
          do p = 1, n
-            c1 = axis_cell(x(1, p), 1)
-            c2 = axis_cell(x(2, p), 2)
-            c3 = axis_cell(x(3, p), 3)
+            c1 = grid_cell_along(self, x(1, p), 1)
+            c2 = grid_cell_along(self, x(2, p), 2)
+            c3 = grid_cell_along(self, x(3, p), 3)
             inside = merge(1, 0, min(c1 - lo(1), hi(1) - c1, c2 - lo(2), hi(2) - c2, c3 - lo(3), hi(3) - c3) >= 0)
             cell(p) = inside * (1 + (c1 - lo(1)) + ((c2 - lo(2)) + (c3 - lo(3)) * n2) * n1)
             missing = missing + (1 - inside)
          end do
          outside = missing
       end subroutine cells_3d
-      !> The global cell along axis k, as grid_owned_local_cell finds it (the last face belongs to the last
-      !> cell).
-      pure integer function axis_cell(xk, k) result(c)
-         real(rp), intent(in) :: xk
-         integer, intent(in) :: k
-         real(rp) :: s
-         s = (xk - self%origin(k)) * self%inv_h
-         c = floor(s)
-         c = c - merge(1, 0, c == self%global_cells(k)) &
-             * merge(1, 0, s <= real(self%global_cells(k), rp) * (1 + epsilon(s)))
-      end function axis_cell
    end subroutine grid_owned_local_cells
 end module background_grid

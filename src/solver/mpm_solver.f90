@@ -499,12 +499,13 @@ contains
       ! the safeguard against the moving walls and structures where they are at the step's end
       call place_moving_walls(self%walls, self%grid, self%time + dt)
       if (self%contact%active) then
-         call keep_particles_inside(self%walls, self%grid, self%particles, self%wall_corrections, self%loads%step_impulse, &
-                                    self%contact%particle_field, self%contact%wall_friction(size(self%walls)), &
-                                    self%loads%field_impulse, skip=self%rigid%rigid_material)
+         call keep_particles_inside(self%walls, self%grid, self%particles, self%extent(:, 1), self%extent(:, 2), &
+                                    self%wall_corrections, self%loads%step_impulse, self%contact%particle_field, &
+                                    self%contact%wall_friction(size(self%walls)), self%loads%field_impulse, &
+                                    skip=self%rigid%rigid_material)
       else
-         call keep_particles_inside(self%walls, self%grid, self%particles, self%wall_corrections, &
-                                    self%loads%step_impulse, skip=self%rigid%rigid_material)
+         call keep_particles_inside(self%walls, self%grid, self%particles, self%extent(:, 1), self%extent(:, 2), &
+                                    self%wall_corrections, self%loads%step_impulse, skip=self%rigid%rigid_material)
       end if
       call self%timers%switch_to(phase_loads)
       call self%loads%end_step(self%walls)
@@ -821,26 +822,29 @@ contains
       end subroutine divide_3d
    end subroutine momenta_to_velocities
 
-   !> The largest |v_p|^2 and the lowest density of a slice of particles (local_speeds) in one pass, which
-   !> the compiler vectorises (it was 4 % of a 2-D step as a scalar loop): per dimension, the velocities of
-   !> a known leading dimension, without inner loops, and NaNs counted in an integer (max and min are exact,
-   !> so the order does not matter). |v|^2 is summed from 0 as sum() does, so that the compiler fuses the
-   !> same multiplications into its additions and the step is the same bit for bit (v1^2 + v2^2 fused the
-   !> other one). A NaN density (the health check reports it) is passed over as minval
-   !> does: a vectorised min need not pass it over, so then a scalar pass.
+   !> The largest |v_p|^2 and the lowest density of a slice of particles (local_speeds), in loops the compiler
+   !> vectorises (one scalar loop for both was 4 % of a 2-D step; max and min are exact, so the order does
+   !> not matter). The speeds per dimension, the velocities of a known leading dimension; |v|^2 summed from
+   !> 0 as sum() does, so that the compiler fuses the same multiplications into its additions and the step
+   !> is the same bit for bit (v1^2 + v2^2 fused the other one). NaN densities counted in an integer (a
+   !> logical reduction keeps the loop scalar): a NaN density (the health check reports it) is passed over
+   !> as minval does, which a vectorised min need not do, so then a scalar pass.
    pure subroutine fastest_and_lightest(v, density, speed2, rho_min)
       real(rp), intent(in), contiguous :: v(:, :), density(:)
       real(rp), intent(out) :: speed2, rho_min
       integer :: n, p, nans
       n = size(density)
-      speed2 = 0.0_rp
+      if (size(v, 1) == 2) then
+         speed2 = largest_2d(v)
+      else
+         speed2 = largest_3d(v)
+      end if
       rho_min = huge(1.0_rp)
       nans = 0
-      if (size(v, 1) == 2) then
-         call pass_2d(v, speed2, rho_min, nans)
-      else
-         call pass_3d(v, speed2, rho_min, nans)
-      end if
+      do p = 1, n
+         rho_min = min(rho_min, density(p))
+         nans = nans + merge(1, 0, ieee_is_nan(density(p)))
+      end do
       if (nans > 0) then
          rho_min = huge(1.0_rp)
          do p = 1, n
@@ -848,37 +852,31 @@ contains
          end do
       end if
    contains
-      pure subroutine pass_2d(v, speed2, rho_min, nans)
+      pure real(rp) function largest_2d(v) result(largest)
          real(rp), intent(in) :: v(2, n)
-         real(rp), intent(inout) :: speed2, rho_min
-         integer, intent(inout) :: nans
          real(rp) :: v2
          integer :: p
+         largest = 0.0_rp
          do p = 1, n
             v2 = 0.0_rp
             v2 = v2 + v(1, p)**2
             v2 = v2 + v(2, p)**2
-            speed2 = max(speed2, v2)
-            rho_min = min(rho_min, density(p))
-            nans = nans + merge(1, 0, ieee_is_nan(density(p)))
+            largest = max(largest, v2)
          end do
-      end subroutine pass_2d
-      pure subroutine pass_3d(v, speed2, rho_min, nans)
+      end function largest_2d
+      pure real(rp) function largest_3d(v) result(largest)
          real(rp), intent(in) :: v(3, n)
-         real(rp), intent(inout) :: speed2, rho_min
-         integer, intent(inout) :: nans
          real(rp) :: v2
          integer :: p
+         largest = 0.0_rp
          do p = 1, n
             v2 = 0.0_rp
             v2 = v2 + v(1, p)**2
             v2 = v2 + v(2, p)**2
             v2 = v2 + v(3, p)**2
-            speed2 = max(speed2, v2)
-            rho_min = min(rho_min, density(p))
-            nans = nans + merge(1, 0, ieee_is_nan(density(p)))
+            largest = max(largest, v2)
          end do
-      end subroutine pass_3d
+      end function largest_3d
    end subroutine fastest_and_lightest
 
    !> The stable step `dt` from the speeds of all ranks (local_speeds, reduced), and a bound `speed`
