@@ -47,6 +47,7 @@ module mpm_solver
    use rigid_bodies, only: rigid_set_t
    use world_frame, only: frame_t, place_grid
    use grid_transfer, only: particles_to_grid, update_velocity_and_remap, grid_to_particles
+   use stencil_cache, only: stencil_cache_t, forget_stencils
    use run_diagnostics, only: diagnostics_t, compute_diagnostics
    use active_region, only: scene_extent, particle_extent, cells_of_extent, guard_cells, box_needs_change, target_box, &
                             slack_cells
@@ -91,6 +92,7 @@ module mpm_solver
       real(rp) :: mass_tolerance = 0.0_rp       !< nodes lighter than this carry no velocity
       logical :: musl = .false.
       real(rp), allocatable :: remapped_momentum(:, :)
+      type(stencil_cache_t) :: stencils        !< the particles' stencils from P2G to G2P of a step (3-D)
       real(rp) :: extent(3, 2) = 0.0_rp         !< lowest and highest particle position after the last move
       integer :: relayouts = 0                  !< layouts made because the particles outgrew the active region
       !> the time loop's flags, carried by the step's one reduction (follow_particles) instead of a reduction
@@ -429,6 +431,7 @@ contains
       end if
       context%domain => self%domain
       context%grid => self%grid
+      context%stencils => self%stencils
       context%dt = dt
       ! a scheme of a material no body or opened inlet supplies has no particles on any rank: skip it (its
       ! halo exchange and cell scans); a supplied one runs on every rank, with or without particles there
@@ -442,9 +445,9 @@ contains
       if (self%contact%active) then
          call self%contact%assign_fields(self%particles)
          call particles_to_grid(self%grid, self%particles, self%gravity, self%contact%particle_field, &
-                                self%contact%field_row)
+                                self%contact%field_row, stencils=self%stencils)
       else
-         call particles_to_grid(self%grid, self%particles, self%gravity)
+         call particles_to_grid(self%grid, self%particles, self%gravity, stencils=self%stencils)
       end if
       call self%timers%switch_to(phase_halo)
       call sum_shared_nodes(self%domain, self%grid, self%grid%accumulated)
@@ -626,7 +629,8 @@ contains
       type(solver_t), intent(inout) :: self
       if (self%contact%active) then
          call update_velocity_and_remap(self%grid, self%particles, self%run%flip_fraction, self%contact%remapped, &
-                                        self%contact%particle_field, self%contact%velocity, self%contact%increment)
+                                        self%contact%particle_field, self%contact%velocity, self%contact%increment, &
+                                        self%stencils)
          if (self%rigid%active) call self%rigid%remap_correction(self%grid, self%particles, self%contact%remapped, &
                                                                  self%contact%particle_field)
          call self%timers%switch_to(phase_halo)
@@ -636,7 +640,8 @@ contains
          call self%timers%switch_to(phase_grid_to_particles)
          return
       end if
-      call update_velocity_and_remap(self%grid, self%particles, self%run%flip_fraction, self%remapped_momentum)
+      call update_velocity_and_remap(self%grid, self%particles, self%run%flip_fraction, self%remapped_momentum, &
+                                     stencils=self%stencils)
       if (self%rigid%active) call self%rigid%remap_correction(self%grid, self%particles, self%remapped_momentum)
       call self%timers%switch_to(phase_halo)
       call sum_shared_nodes(self%domain, self%grid, self%remapped_momentum)
@@ -699,6 +704,7 @@ contains
             deallocate (spin)
          end if
       end do
+      call forget_stencils(self%stencils)     ! the particles moved
 
    contains
 
@@ -712,23 +718,27 @@ contains
                                       update_velocity=.false., compute_strain=.true., update_position=.true., &
                                       strain_velocity=contact%remapped, compute_spin=uses_spin, extent=extent, &
                                       field=contact%particle_field, velocity=contact%velocity, &
-                                      increment=contact%increment, first=first, last=last, strain_rate=d, spin=w)
+                                      increment=contact%increment, first=first, last=last, strain_rate=d, spin=w, &
+                                      stencils=self%stencils)
             else if (contact%active) then
                call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
                                       update_velocity=.true., compute_strain=.true., update_position=.true., &
                                       compute_spin=uses_spin, extent=extent, field=contact%particle_field, &
                                       velocity=contact%velocity, increment=contact%increment, first=first, &
-                                      last=last, strain_rate=d, spin=w)
+                                      last=last, strain_rate=d, spin=w, &
+                                      stencils=self%stencils)
             else if (self%musl) then
                call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
                                       update_velocity=.false., compute_strain=.true., update_position=.true., &
                                       strain_velocity=self%remapped_momentum, compute_spin=uses_spin, &
-                                      extent=extent, first=first, last=last, strain_rate=d, spin=w)
+                                      extent=extent, first=first, last=last, strain_rate=d, spin=w, &
+                                      stencils=self%stencils)
             else
                call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
                                       update_velocity=.true., compute_strain=.true., update_position=.true., &
                                       compute_spin=uses_spin, extent=extent, first=first, last=last, &
-                                      strain_rate=d, spin=w)
+                                      strain_rate=d, spin=w, &
+                                      stencils=self%stencils)
             end if
          end associate
          self%extent(1:dim, 1) = min(self%extent(1:dim, 1), extent(1:dim, 1))

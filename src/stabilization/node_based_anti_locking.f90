@@ -57,11 +57,12 @@ contains
             associate (mass => self%nodal_mass(:, 1:grid%node_count))
                mass = 0.0_rp
                call store_shape_values(grid, particles, context%first, context%last, self%base, self%weight, &
-                                       mass(1, :))
+                                       mass(1, :), context%stencils)
                call sum_shared_nodes(context%domain, grid, mass)
             end associate
          else
-            call store_shape_values(grid, particles, context%first, context%last, self%base, self%weight)
+            call store_shape_values(grid, particles, context%first, context%last, self%base, self%weight, &
+                                    stencils=context%stencils)
          end if
       end associate
    end subroutine nb_prepare

@@ -8,6 +8,7 @@ module node_based_kernels
    use background_grid, only: grid_t
    use shape_functions, only: shape_bspline2
    use particle_set, only: particle_set_t
+   use stencil_cache, only: stencil_cache_t, holds_stencils
    implicit none
    private
 
@@ -24,18 +25,19 @@ contains
 
    !> base(q), weight(:, q) = N_a(x_p^n) of particles p = first..last (q = p - first + 1) and, with
    !> `mass`, mass(i) += N_ip m_p.
-   subroutine store_shape_values(grid, particles, first, last, base, weight, mass)
+   subroutine store_shape_values(grid, particles, first, last, base, weight, mass, stencils)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(in) :: particles
       integer, intent(in) :: first, last
       integer, intent(inout), contiguous :: base(:)
       real(rp), intent(inout), contiguous :: weight(:, :)
       real(rp), intent(inout), optional, contiguous :: mass(:)
+      type(stencil_cache_t), intent(in), optional :: stencils
       select case (instance(grid))
       case (1); call store_2d(grid, particles, first, last, base, weight, mass)
-      case (2); call store_3d(grid, particles, first, last, base, weight, mass)
+      case (2); call store_3d(grid, particles, first, last, base, weight, mass, stencils)
       case (3); call store_b2_2d(grid, particles, first, last, base, weight, mass)
-      case default; call store_b2_3d(grid, particles, first, last, base, weight, mass)
+      case default; call store_b2_3d(grid, particles, first, last, base, weight, mass, stencils)
       end select
    end subroutine store_shape_values
 

@@ -10,6 +10,7 @@ module stabilizer
    use domain_decomposition, only: domain_t
    use background_grid, only: grid_t
    use particle_set, only: particle_set_t
+   use stencil_cache, only: stencil_cache_t
    implicit none
    private
 
@@ -23,6 +24,7 @@ module stabilizer
       !> the material is the only one with particles, on every rank: the grid's mass row of the step's P2G
       !> is its nodal mass (NB uses it)
       logical :: sole_material = .false.
+      type(stencil_cache_t), pointer :: stencils => null()   !< P2G's stencils of this step (3-D; valid until G2P)
    end type stage_context_t
 
    type, abstract, public :: stabilizer_t

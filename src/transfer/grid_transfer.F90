@@ -11,6 +11,7 @@ module grid_transfer
    use background_grid, only: grid_t, row_mass
    use shape_functions, only: shape_bspline2
    use particle_set, only: particle_set_t
+   use stencil_cache, only: stencil_cache_t, size_stencil_cache, holds_stencils, forget_stencils
    implicit none
    private
 
@@ -43,36 +44,55 @@ contains
    !> With `field` (contact, src/solver/body_contact.f90): also each body field's mass, momentum, force and
    !> mass gradient sum m_p grad N_i in its rows of grid%accumulated from `field_row` on (field(p) = 0: the
    !> common field, only in the totals).
-   subroutine particles_to_grid(grid, particles, gravity, field, field_row)
+   !> With `stencils` (3-D): each particle's stencil is kept there for the later passes of the same step
+   !> (src/transfer/stencil_cache.f90).
+   subroutine particles_to_grid(grid, particles, gravity, field, field_row, stencils)
       type(grid_t), intent(inout) :: grid
       type(particle_set_t), intent(in) :: particles
       real(rp), intent(in) :: gravity(:)
       integer, intent(in), optional :: field(:), field_row
+      type(stencil_cache_t), intent(inout), optional, target :: stencils
+      type(stencil_cache_t), target :: no_cache
+      type(stencil_cache_t), pointer :: cache
+      logical :: use_cache
       grid%accumulated = 0.0_rp
+      cache => no_cache
+      use_cache = .false.
+      if (present(stencils)) then
+         call forget_stencils(stencils)
+         use_cache = grid%dim == 3       ! the 2-D kernels locate a block of particles at a time (vectorised)
+         if (use_cache) then
+            call size_stencil_cache(stencils, size(particles%mass))
+            cache => stencils
+         end if
+      end if
       if (present(field)) then
          select case (transfer_instance(grid, particles))
          case (kernels_linear_2d); call particles_to_grid_fields_2d(grid, particles, gravity, field, field_row)
-         case (kernels_linear_3d); call particles_to_grid_fields_3d(grid, particles, gravity, field, field_row)
+         case (kernels_linear_3d); call particles_to_grid_fields_3d(grid, particles, gravity, field, field_row, cache, use_cache)
          case (kernels_bspline2_2d); call particles_to_grid_fields_b2_2d(grid, particles, gravity, field, field_row)
-         case (kernels_bspline2_3d); call particles_to_grid_fields_b2_3d(grid, particles, gravity, field, field_row)
+         case (kernels_bspline2_3d)
+            call particles_to_grid_fields_b2_3d(grid, particles, gravity, field, field_row, cache, use_cache)
          case (apic + kernels_linear_2d); call particles_to_grid_fields_apic_2d(grid, particles, gravity, field, field_row)
-         case (apic + kernels_linear_3d); call particles_to_grid_fields_apic_3d(grid, particles, gravity, field, field_row)
+         case (apic + kernels_linear_3d)
+            call particles_to_grid_fields_apic_3d(grid, particles, gravity, field, field_row, cache, use_cache)
          case (apic + kernels_bspline2_2d)
             call particles_to_grid_fields_apic_b2_2d(grid, particles, gravity, field, field_row)
-         case default; call particles_to_grid_fields_apic_b2_3d(grid, particles, gravity, field, field_row)
+         case default; call particles_to_grid_fields_apic_b2_3d(grid, particles, gravity, field, field_row, cache, use_cache)
          end select
       else
          select case (transfer_instance(grid, particles))
          case (kernels_linear_2d); call particles_to_grid_2d(grid, particles, gravity)
-         case (kernels_linear_3d); call particles_to_grid_3d(grid, particles, gravity)
+         case (kernels_linear_3d); call particles_to_grid_3d(grid, particles, gravity, cache, use_cache)
          case (kernels_bspline2_2d); call particles_to_grid_b2_2d(grid, particles, gravity)
-         case (kernels_bspline2_3d); call particles_to_grid_b2_3d(grid, particles, gravity)
+         case (kernels_bspline2_3d); call particles_to_grid_b2_3d(grid, particles, gravity, cache, use_cache)
          case (apic + kernels_linear_2d); call particles_to_grid_apic_2d(grid, particles, gravity)
-         case (apic + kernels_linear_3d); call particles_to_grid_apic_3d(grid, particles, gravity)
+         case (apic + kernels_linear_3d); call particles_to_grid_apic_3d(grid, particles, gravity, cache, use_cache)
          case (apic + kernels_bspline2_2d); call particles_to_grid_apic_b2_2d(grid, particles, gravity)
-         case default; call particles_to_grid_apic_b2_3d(grid, particles, gravity)
+         case default; call particles_to_grid_apic_b2_3d(grid, particles, gravity, cache, use_cache)
          end select
       end if
+      if (use_cache) stencils%count = particles%count
    end subroutine particles_to_grid
 
    !> MUSL, first half of step 7 fused with the re-map: v_p := alpha (v_p + sum N dv_i) + (1 - alpha) sum N
@@ -80,43 +100,50 @@ contains
    !> APIC: v_p := sum N v_i^{n+1}, C_p := B_p D_p^-1 from v_i^{n+1}, and the momentum as in step 1.
    !> With `field`: each particle's nodal velocities come from its field's rows of `velocity` and
    !> `increment` (dim (fields + 1), node); momentum rows 1:dim get the total, rows f dim + 1.. field f's.
-   subroutine update_velocity_and_remap(grid, particles, flip_fraction, momentum, field, velocity, increment)
+   !> `stencils`: P2G's of this step (used when it holds this set's particles).
+   subroutine update_velocity_and_remap(grid, particles, flip_fraction, momentum, field, velocity, increment, stencils)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
       real(rp), intent(in) :: flip_fraction
       real(rp), intent(out), contiguous :: momentum(:, :)
       integer, intent(in), optional :: field(:)
       real(rp), intent(in), optional, contiguous :: velocity(:, :), increment(:, :)
+      type(stencil_cache_t), intent(in), optional, target :: stencils
+      type(stencil_cache_t), target :: no_cache
+      type(stencil_cache_t), pointer :: cache
+      logical :: use_cache
+      call choose_cache(grid, particles, no_cache, cache, use_cache, stencils)
       momentum = 0.0_rp
       if (present(field)) then
          select case (transfer_instance(grid, particles))
          case (kernels_linear_2d)
             call momentum_to_grid_fields_2d(grid, particles, flip_fraction, momentum, field, velocity, increment)
          case (kernels_linear_3d)
-            call momentum_to_grid_fields_3d(grid, particles, flip_fraction, momentum, field, velocity, increment)
+            call momentum_to_grid_fields_3d(grid, particles, flip_fraction, momentum, field, velocity, increment, cache, use_cache)
          case (kernels_bspline2_2d)
             call momentum_to_grid_fields_b2_2d(grid, particles, flip_fraction, momentum, field, velocity, increment)
          case (kernels_bspline2_3d)
-            call momentum_to_grid_fields_b2_3d(grid, particles, flip_fraction, momentum, field, velocity, increment)
+            call momentum_to_grid_fields_b2_3d(grid, particles, flip_fraction, momentum, field, velocity, increment, cache, &
+                                               use_cache)
          case (apic + kernels_linear_2d)
             call momentum_to_grid_fields_apic_2d(grid, particles, momentum, field, velocity, increment)
          case (apic + kernels_linear_3d)
-            call momentum_to_grid_fields_apic_3d(grid, particles, momentum, field, velocity, increment)
+            call momentum_to_grid_fields_apic_3d(grid, particles, momentum, field, velocity, increment, cache, use_cache)
          case (apic + kernels_bspline2_2d)
             call momentum_to_grid_fields_apic_b2_2d(grid, particles, momentum, field, velocity, increment)
          case default
-            call momentum_to_grid_fields_apic_b2_3d(grid, particles, momentum, field, velocity, increment)
+            call momentum_to_grid_fields_apic_b2_3d(grid, particles, momentum, field, velocity, increment, cache, use_cache)
          end select
       else
          select case (transfer_instance(grid, particles))
          case (kernels_linear_2d); call momentum_to_grid_2d(grid, particles, flip_fraction, momentum)
-         case (kernels_linear_3d); call momentum_to_grid_3d(grid, particles, flip_fraction, momentum)
+         case (kernels_linear_3d); call momentum_to_grid_3d(grid, particles, flip_fraction, momentum, cache, use_cache)
          case (kernels_bspline2_2d); call momentum_to_grid_b2_2d(grid, particles, flip_fraction, momentum)
-         case (kernels_bspline2_3d); call momentum_to_grid_b2_3d(grid, particles, flip_fraction, momentum)
+         case (kernels_bspline2_3d); call momentum_to_grid_b2_3d(grid, particles, flip_fraction, momentum, cache, use_cache)
          case (apic + kernels_linear_2d); call momentum_to_grid_apic_2d(grid, particles, momentum)
-         case (apic + kernels_linear_3d); call momentum_to_grid_apic_3d(grid, particles, momentum)
+         case (apic + kernels_linear_3d); call momentum_to_grid_apic_3d(grid, particles, momentum, cache, use_cache)
          case (apic + kernels_bspline2_2d); call momentum_to_grid_apic_b2_2d(grid, particles, momentum)
-         case default; call momentum_to_grid_apic_b2_3d(grid, particles, momentum)
+         case default; call momentum_to_grid_apic_b2_3d(grid, particles, momentum, cache, use_cache)
          end select
       end if
    end subroutine update_velocity_and_remap
@@ -136,9 +163,10 @@ contains
    !> column p - first + 1 of `strain_rate` (n_sigma rows when compute_strain) and `spin` (no rows: no
    !> spin): the particles' own arrays, or the block buffer of the solver's fused stage, on which the
    !> stress update follows while it is in cache (docs/performance.md, "Memory per particle").
+   !> `stencils`: P2G's of this step (used when it holds this set's particles).
    subroutine grid_to_particles(grid, particles, dt, flip_fraction, theta, update_velocity, compute_strain, &
                                 update_position, strain_rate, spin, strain_velocity, compute_spin, extent, field, &
-                                velocity, increment, first, last)
+                                velocity, increment, first, last, stencils)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
       real(rp), intent(in) :: dt, flip_fraction, theta
@@ -150,9 +178,14 @@ contains
       integer, intent(in), optional :: field(:)
       real(rp), intent(in), optional, contiguous :: velocity(:, :), increment(:, :)
       integer, intent(in), optional :: first, last
+      type(stencil_cache_t), intent(in), optional, target :: stencils
+      type(stencil_cache_t), target :: no_cache
+      type(stencil_cache_t), pointer :: cache
+      logical :: use_cache
       real(rp) :: lo(3), hi(3)
       integer :: p1, p2
       logical :: with_spin
+      call choose_cache(grid, particles, no_cache, cache, use_cache, stencils)
       p1 = 1
       p2 = particles%count
       if (present(first)) p1 = first
@@ -171,7 +204,7 @@ contains
          case (kernels_linear_3d)
             call grid_to_particles_fields_3d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
                                              compute_strain, with_spin, update_position, strain_rate, spin, lo, hi, &
-                                             field, velocity, increment, strain_velocity)
+                                             field, velocity, increment, strain_velocity, cache, use_cache)
          case (kernels_bspline2_2d)
             call grid_to_particles_fields_b2_2d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
                                                 compute_strain, with_spin, update_position, strain_rate, spin, &
@@ -179,7 +212,7 @@ contains
          case (kernels_bspline2_3d)
             call grid_to_particles_fields_b2_3d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
                                                 compute_strain, with_spin, update_position, strain_rate, spin, lo, &
-                                                hi, field, velocity, increment, strain_velocity)
+                                                hi, field, velocity, increment, strain_velocity, cache, use_cache)
          case (apic + kernels_linear_2d)
             call grid_to_particles_fields_apic_2d(grid, particles, p1, p2, dt, theta, update_velocity, &
                                                   compute_strain, with_spin, update_position, strain_rate, spin, &
@@ -187,7 +220,7 @@ contains
          case (apic + kernels_linear_3d)
             call grid_to_particles_fields_apic_3d(grid, particles, p1, p2, dt, theta, update_velocity, &
                                                   compute_strain, with_spin, update_position, strain_rate, spin, &
-                                                  lo, hi, field, velocity, increment, strain_velocity)
+                                                  lo, hi, field, velocity, increment, strain_velocity, cache, use_cache)
          case (apic + kernels_bspline2_2d)
             call grid_to_particles_fields_apic_b2_2d(grid, particles, p1, p2, dt, theta, update_velocity, &
                                                      compute_strain, with_spin, update_position, strain_rate, spin, &
@@ -195,7 +228,7 @@ contains
          case default
             call grid_to_particles_fields_apic_b2_3d(grid, particles, p1, p2, dt, theta, update_velocity, &
                                                      compute_strain, with_spin, update_position, strain_rate, spin, &
-                                                     lo, hi, field, velocity, increment, strain_velocity)
+                                                     lo, hi, field, velocity, increment, strain_velocity, cache, use_cache)
          end select
       else
          select case (transfer_instance(grid, particles))
@@ -206,7 +239,7 @@ contains
          case (kernels_linear_3d)
             call grid_to_particles_3d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
                                       compute_strain, with_spin, update_position, strain_rate, spin, lo, hi, &
-                                      strain_velocity)
+                                      strain_velocity, cache, use_cache)
          case (kernels_bspline2_2d)
             call grid_to_particles_b2_2d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
                                          compute_strain, with_spin, update_position, strain_rate, spin, lo(1:2), &
@@ -214,14 +247,14 @@ contains
          case (kernels_bspline2_3d)
             call grid_to_particles_b2_3d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
                                          compute_strain, with_spin, update_position, strain_rate, spin, lo, hi, &
-                                         strain_velocity)
+                                         strain_velocity, cache, use_cache)
          case (apic + kernels_linear_2d)
             call grid_to_particles_apic_2d(grid, particles, p1, p2, dt, theta, update_velocity, compute_strain, &
                                            with_spin, update_position, strain_rate, spin, lo(1:2), hi(1:2), &
                                            strain_velocity)
          case (apic + kernels_linear_3d)
             call grid_to_particles_apic_3d(grid, particles, p1, p2, dt, theta, update_velocity, compute_strain, &
-                                           with_spin, update_position, strain_rate, spin, lo, hi, strain_velocity)
+                                           with_spin, update_position, strain_rate, spin, lo, hi, strain_velocity, cache, use_cache)
          case (apic + kernels_bspline2_2d)
             call grid_to_particles_apic_b2_2d(grid, particles, p1, p2, dt, theta, update_velocity, compute_strain, &
                                               with_spin, update_position, strain_rate, spin, lo(1:2), hi(1:2), &
@@ -229,7 +262,7 @@ contains
          case default
             call grid_to_particles_apic_b2_3d(grid, particles, p1, p2, dt, theta, update_velocity, compute_strain, &
                                               with_spin, update_position, strain_rate, spin, lo, hi, &
-                                              strain_velocity)
+                                              strain_velocity, cache, use_cache)
          end select
       end if
       if (present(extent)) then
@@ -237,6 +270,23 @@ contains
          extent(:, 2) = hi
       end if
    end subroutine grid_to_particles
+
+   !> The cache the 3-D kernels read: `stencils` if given and holding this set's particles (use_cache), else
+   !> the caller's empty `no_cache` (the kernels locate the particles themselves).
+   subroutine choose_cache(grid, particles, no_cache, cache, use_cache, stencils)
+      type(grid_t), intent(in) :: grid
+      type(particle_set_t), intent(in) :: particles
+      type(stencil_cache_t), intent(in), target :: no_cache
+      type(stencil_cache_t), pointer, intent(out) :: cache
+      logical, intent(out) :: use_cache
+      type(stencil_cache_t), intent(in), optional, target :: stencils
+      cache => no_cache
+      use_cache = .false.
+      if (.not. present(stencils)) return
+      if (grid%dim /= 3 .or. .not. holds_stencils(stencils, particles%count)) return
+      cache => stencils
+      use_cache = .true.
+   end subroutine choose_cache
 
    !> d(:, a) = x_a - x_p for the stencil nodes a of a particle at fractional position xi in a cell of
    !> edge h, multilinear functions (APIC's offsets; exposed for the tests of D_p): node a's offset along
