@@ -51,48 +51,42 @@ contains
       type(particle_set_t), intent(in) :: particles
       real(rp), intent(in) :: gravity(:)
       integer, intent(in), optional :: field(:), field_row
-      type(stencil_cache_t), intent(inout), optional, target :: stencils
-      type(stencil_cache_t), target :: no_cache
-      type(stencil_cache_t), pointer :: cache
-      logical :: use_cache
+      type(stencil_cache_t), intent(inout), optional :: stencils
       grid%accumulated = 0.0_rp
-      cache => no_cache
-      use_cache = .false.
       if (present(stencils)) then
          call forget_stencils(stencils)
-         use_cache = grid%dim == 3       ! the 2-D kernels locate a block of particles at a time (vectorised)
-         if (use_cache) then
-            call size_stencil_cache(stencils, size(particles%mass))
-            cache => stencils
-         end if
+         ! only the 3-D kernels keep stencils: the 2-D ones locate a block of particles at a time, vectorised
+         if (grid%dim == 3) call size_stencil_cache(stencils, size(particles%mass))
       end if
       if (present(field)) then
          select case (transfer_instance(grid, particles))
          case (kernels_linear_2d); call particles_to_grid_fields_2d(grid, particles, gravity, field, field_row)
-         case (kernels_linear_3d); call particles_to_grid_fields_3d(grid, particles, gravity, field, field_row, cache, use_cache)
+         case (kernels_linear_3d); call particles_to_grid_fields_3d(grid, particles, gravity, field, field_row, stencils)
          case (kernels_bspline2_2d); call particles_to_grid_fields_b2_2d(grid, particles, gravity, field, field_row)
          case (kernels_bspline2_3d)
-            call particles_to_grid_fields_b2_3d(grid, particles, gravity, field, field_row, cache, use_cache)
+            call particles_to_grid_fields_b2_3d(grid, particles, gravity, field, field_row, stencils)
          case (apic + kernels_linear_2d); call particles_to_grid_fields_apic_2d(grid, particles, gravity, field, field_row)
          case (apic + kernels_linear_3d)
-            call particles_to_grid_fields_apic_3d(grid, particles, gravity, field, field_row, cache, use_cache)
+            call particles_to_grid_fields_apic_3d(grid, particles, gravity, field, field_row, stencils)
          case (apic + kernels_bspline2_2d)
             call particles_to_grid_fields_apic_b2_2d(grid, particles, gravity, field, field_row)
-         case default; call particles_to_grid_fields_apic_b2_3d(grid, particles, gravity, field, field_row, cache, use_cache)
+         case default; call particles_to_grid_fields_apic_b2_3d(grid, particles, gravity, field, field_row, stencils)
          end select
       else
          select case (transfer_instance(grid, particles))
          case (kernels_linear_2d); call particles_to_grid_2d(grid, particles, gravity)
-         case (kernels_linear_3d); call particles_to_grid_3d(grid, particles, gravity, cache, use_cache)
+         case (kernels_linear_3d); call particles_to_grid_3d(grid, particles, gravity, stencils)
          case (kernels_bspline2_2d); call particles_to_grid_b2_2d(grid, particles, gravity)
-         case (kernels_bspline2_3d); call particles_to_grid_b2_3d(grid, particles, gravity, cache, use_cache)
+         case (kernels_bspline2_3d); call particles_to_grid_b2_3d(grid, particles, gravity, stencils)
          case (apic + kernels_linear_2d); call particles_to_grid_apic_2d(grid, particles, gravity)
-         case (apic + kernels_linear_3d); call particles_to_grid_apic_3d(grid, particles, gravity, cache, use_cache)
+         case (apic + kernels_linear_3d); call particles_to_grid_apic_3d(grid, particles, gravity, stencils)
          case (apic + kernels_bspline2_2d); call particles_to_grid_apic_b2_2d(grid, particles, gravity)
-         case default; call particles_to_grid_apic_b2_3d(grid, particles, gravity, cache, use_cache)
+         case default; call particles_to_grid_apic_b2_3d(grid, particles, gravity, stencils)
          end select
       end if
-      if (use_cache) stencils%count = particles%count
+      if (present(stencils)) then
+         if (grid%dim == 3) stencils%count = particles%count
+      end if
    end subroutine particles_to_grid
 
    !> MUSL, first half of step 7 fused with the re-map: v_p := alpha (v_p + sum N dv_i) + (1 - alpha) sum N
@@ -108,42 +102,37 @@ contains
       real(rp), intent(out), contiguous :: momentum(:, :)
       integer, intent(in), optional :: field(:)
       real(rp), intent(in), optional, contiguous :: velocity(:, :), increment(:, :)
-      type(stencil_cache_t), intent(in), optional, target :: stencils
-      type(stencil_cache_t), target :: no_cache
-      type(stencil_cache_t), pointer :: cache
-      logical :: use_cache
-      call choose_cache(grid, particles, no_cache, cache, use_cache, stencils)
+      type(stencil_cache_t), intent(in), optional :: stencils
       momentum = 0.0_rp
       if (present(field)) then
          select case (transfer_instance(grid, particles))
          case (kernels_linear_2d)
             call momentum_to_grid_fields_2d(grid, particles, flip_fraction, momentum, field, velocity, increment)
          case (kernels_linear_3d)
-            call momentum_to_grid_fields_3d(grid, particles, flip_fraction, momentum, field, velocity, increment, cache, use_cache)
+            call momentum_to_grid_fields_3d(grid, particles, flip_fraction, momentum, field, velocity, increment, stencils)
          case (kernels_bspline2_2d)
             call momentum_to_grid_fields_b2_2d(grid, particles, flip_fraction, momentum, field, velocity, increment)
          case (kernels_bspline2_3d)
-            call momentum_to_grid_fields_b2_3d(grid, particles, flip_fraction, momentum, field, velocity, increment, cache, &
-                                               use_cache)
+            call momentum_to_grid_fields_b2_3d(grid, particles, flip_fraction, momentum, field, velocity, increment, stencils)
          case (apic + kernels_linear_2d)
             call momentum_to_grid_fields_apic_2d(grid, particles, momentum, field, velocity, increment)
          case (apic + kernels_linear_3d)
-            call momentum_to_grid_fields_apic_3d(grid, particles, momentum, field, velocity, increment, cache, use_cache)
+            call momentum_to_grid_fields_apic_3d(grid, particles, momentum, field, velocity, increment, stencils)
          case (apic + kernels_bspline2_2d)
             call momentum_to_grid_fields_apic_b2_2d(grid, particles, momentum, field, velocity, increment)
          case default
-            call momentum_to_grid_fields_apic_b2_3d(grid, particles, momentum, field, velocity, increment, cache, use_cache)
+            call momentum_to_grid_fields_apic_b2_3d(grid, particles, momentum, field, velocity, increment, stencils)
          end select
       else
          select case (transfer_instance(grid, particles))
          case (kernels_linear_2d); call momentum_to_grid_2d(grid, particles, flip_fraction, momentum)
-         case (kernels_linear_3d); call momentum_to_grid_3d(grid, particles, flip_fraction, momentum, cache, use_cache)
+         case (kernels_linear_3d); call momentum_to_grid_3d(grid, particles, flip_fraction, momentum, stencils)
          case (kernels_bspline2_2d); call momentum_to_grid_b2_2d(grid, particles, flip_fraction, momentum)
-         case (kernels_bspline2_3d); call momentum_to_grid_b2_3d(grid, particles, flip_fraction, momentum, cache, use_cache)
+         case (kernels_bspline2_3d); call momentum_to_grid_b2_3d(grid, particles, flip_fraction, momentum, stencils)
          case (apic + kernels_linear_2d); call momentum_to_grid_apic_2d(grid, particles, momentum)
-         case (apic + kernels_linear_3d); call momentum_to_grid_apic_3d(grid, particles, momentum, cache, use_cache)
+         case (apic + kernels_linear_3d); call momentum_to_grid_apic_3d(grid, particles, momentum, stencils)
          case (apic + kernels_bspline2_2d); call momentum_to_grid_apic_b2_2d(grid, particles, momentum)
-         case default; call momentum_to_grid_apic_b2_3d(grid, particles, momentum, cache, use_cache)
+         case default; call momentum_to_grid_apic_b2_3d(grid, particles, momentum, stencils)
          end select
       end if
    end subroutine update_velocity_and_remap
@@ -178,14 +167,10 @@ contains
       integer, intent(in), optional :: field(:)
       real(rp), intent(in), optional, contiguous :: velocity(:, :), increment(:, :)
       integer, intent(in), optional :: first, last
-      type(stencil_cache_t), intent(in), optional, target :: stencils
-      type(stencil_cache_t), target :: no_cache
-      type(stencil_cache_t), pointer :: cache
-      logical :: use_cache
+      type(stencil_cache_t), intent(in), optional :: stencils
       real(rp) :: lo(3), hi(3)
       integer :: p1, p2
       logical :: with_spin
-      call choose_cache(grid, particles, no_cache, cache, use_cache, stencils)
       p1 = 1
       p2 = particles%count
       if (present(first)) p1 = first
@@ -204,7 +189,7 @@ contains
          case (kernels_linear_3d)
             call grid_to_particles_fields_3d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
                                              compute_strain, with_spin, update_position, strain_rate, spin, lo, hi, &
-                                             field, velocity, increment, strain_velocity, cache, use_cache)
+                                             field, velocity, increment, strain_velocity, stencils)
          case (kernels_bspline2_2d)
             call grid_to_particles_fields_b2_2d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
                                                 compute_strain, with_spin, update_position, strain_rate, spin, &
@@ -212,7 +197,7 @@ contains
          case (kernels_bspline2_3d)
             call grid_to_particles_fields_b2_3d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
                                                 compute_strain, with_spin, update_position, strain_rate, spin, lo, &
-                                                hi, field, velocity, increment, strain_velocity, cache, use_cache)
+                                                hi, field, velocity, increment, strain_velocity, stencils)
          case (apic + kernels_linear_2d)
             call grid_to_particles_fields_apic_2d(grid, particles, p1, p2, dt, theta, update_velocity, &
                                                   compute_strain, with_spin, update_position, strain_rate, spin, &
@@ -220,7 +205,7 @@ contains
          case (apic + kernels_linear_3d)
             call grid_to_particles_fields_apic_3d(grid, particles, p1, p2, dt, theta, update_velocity, &
                                                   compute_strain, with_spin, update_position, strain_rate, spin, &
-                                                  lo, hi, field, velocity, increment, strain_velocity, cache, use_cache)
+                                                  lo, hi, field, velocity, increment, strain_velocity, stencils)
          case (apic + kernels_bspline2_2d)
             call grid_to_particles_fields_apic_b2_2d(grid, particles, p1, p2, dt, theta, update_velocity, &
                                                      compute_strain, with_spin, update_position, strain_rate, spin, &
@@ -228,7 +213,7 @@ contains
          case default
             call grid_to_particles_fields_apic_b2_3d(grid, particles, p1, p2, dt, theta, update_velocity, &
                                                      compute_strain, with_spin, update_position, strain_rate, spin, &
-                                                     lo, hi, field, velocity, increment, strain_velocity, cache, use_cache)
+                                                     lo, hi, field, velocity, increment, strain_velocity, stencils)
          end select
       else
          select case (transfer_instance(grid, particles))
@@ -239,7 +224,7 @@ contains
          case (kernels_linear_3d)
             call grid_to_particles_3d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
                                       compute_strain, with_spin, update_position, strain_rate, spin, lo, hi, &
-                                      strain_velocity, cache, use_cache)
+                                      strain_velocity, stencils)
          case (kernels_bspline2_2d)
             call grid_to_particles_b2_2d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
                                          compute_strain, with_spin, update_position, strain_rate, spin, lo(1:2), &
@@ -247,14 +232,14 @@ contains
          case (kernels_bspline2_3d)
             call grid_to_particles_b2_3d(grid, particles, p1, p2, dt, flip_fraction, theta, update_velocity, &
                                          compute_strain, with_spin, update_position, strain_rate, spin, lo, hi, &
-                                         strain_velocity, cache, use_cache)
+                                         strain_velocity, stencils)
          case (apic + kernels_linear_2d)
             call grid_to_particles_apic_2d(grid, particles, p1, p2, dt, theta, update_velocity, compute_strain, &
                                            with_spin, update_position, strain_rate, spin, lo(1:2), hi(1:2), &
                                            strain_velocity)
          case (apic + kernels_linear_3d)
             call grid_to_particles_apic_3d(grid, particles, p1, p2, dt, theta, update_velocity, compute_strain, &
-                                           with_spin, update_position, strain_rate, spin, lo, hi, strain_velocity, cache, use_cache)
+                                           with_spin, update_position, strain_rate, spin, lo, hi, strain_velocity, stencils)
          case (apic + kernels_bspline2_2d)
             call grid_to_particles_apic_b2_2d(grid, particles, p1, p2, dt, theta, update_velocity, compute_strain, &
                                               with_spin, update_position, strain_rate, spin, lo(1:2), hi(1:2), &
@@ -262,7 +247,7 @@ contains
          case default
             call grid_to_particles_apic_b2_3d(grid, particles, p1, p2, dt, theta, update_velocity, compute_strain, &
                                               with_spin, update_position, strain_rate, spin, lo, hi, &
-                                              strain_velocity, cache, use_cache)
+                                              strain_velocity, stencils)
          end select
       end if
       if (present(extent)) then
@@ -270,23 +255,6 @@ contains
          extent(:, 2) = hi
       end if
    end subroutine grid_to_particles
-
-   !> The cache the 3-D kernels read: `stencils` if given and holding this set's particles (use_cache), else
-   !> the caller's empty `no_cache` (the kernels locate the particles themselves).
-   subroutine choose_cache(grid, particles, no_cache, cache, use_cache, stencils)
-      type(grid_t), intent(in) :: grid
-      type(particle_set_t), intent(in) :: particles
-      type(stencil_cache_t), intent(in), target :: no_cache
-      type(stencil_cache_t), pointer, intent(out) :: cache
-      logical, intent(out) :: use_cache
-      type(stencil_cache_t), intent(in), optional, target :: stencils
-      cache => no_cache
-      use_cache = .false.
-      if (.not. present(stencils)) return
-      if (grid%dim /= 3 .or. .not. holds_stencils(stencils, particles%count)) return
-      cache => stencils
-      use_cache = .true.
-   end subroutine choose_cache
 
    !> d(:, a) = x_a - x_p for the stencil nodes a of a particle at fractional position xi in a cell of
    !> edge h, multilinear functions (APIC's offsets; exposed for the tests of D_p): node a's offset along

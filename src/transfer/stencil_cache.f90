@@ -22,11 +22,10 @@ module stencil_cache
 
 contains
 
-   !> Room for `capacity` particles (the particle set's capacity: reallocated when it grew); holds none.
+   !> Room for `capacity` particles (the particle set's capacity: reallocated when it grew).
    subroutine size_stencil_cache(stencils, capacity)
       type(stencil_cache_t), intent(inout) :: stencils
       integer, intent(in) :: capacity
-      stencils%count = -1
       if (allocated(stencils%base)) then
          if (size(stencils%base) >= capacity) return
          deallocate (stencils%base, stencils%xi)
