@@ -14,7 +14,7 @@ module mpm_solver
    use kinds, only: rp, i8
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_Allgather, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_MIN, &
                       MPI_INTEGER8
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use error_status, only: status_t
    use communication_counters, only: count_collective, comm_time_step, comm_balance, comm_other, real_bytes, int8_bytes
    use scene_description, only: scene_t, run_control_t, wall_spec_t, model_newtonian_fluid
@@ -52,7 +52,7 @@ module mpm_solver
    use active_region, only: scene_extent, particle_extent, cells_of_extent, guard_cells, box_needs_change, target_box, &
                             slack_cells
    use status_broadcast, only: agree_on_status
-   use health_check, only: particles_healthy
+   use health_check, only: particles_healthy, motion_scan_t, scan_motion, merge_motion_scans
    use input_text, only: int_text, real_text, group_context
    use phase_timers, only: phase_timers_t, phase_particles_to_grid, phase_grid_update, phase_walls, &
                            phase_stabilization, phase_grid_to_particles, phase_constitutive, phase_inflow, &
@@ -562,8 +562,7 @@ contains
    subroutine update_nodes(self, dt)
       type(solver_t), intent(inout) :: self
       real(rp), intent(in) :: dt
-      integer :: i, dim, mom, frc
-      real(rp) :: m
+      integer :: dim, mom, frc
       real(rp), allocatable :: before_walls(:, :)
       dim = self%grid%dim
       if (self%contact%active) then
@@ -577,16 +576,11 @@ contains
       mom = self%grid%row_momentum
       frc = self%grid%row_force
       associate (acc => self%grid%accumulated, v => self%grid%velocity, dv => self%grid%velocity_increment)
-         do i = 1, self%grid%node_count
-            m = acc(row_mass, i)
-            if (m > self%mass_tolerance) then
-               dv(:, i) = acc(mom:mom + dim - 1, i) / m                 ! v^n, for now
-               v(:, i) = dv(:, i) + dt * acc(frc:frc + dim - 1, i) / m  ! v^{n+1} before walls
-            else
-               dv(:, i) = 0.0_rp
-               v(:, i) = 0.0_rp
-            end if
-         end do
+         if (dim == 2) then
+            call nodal_velocities_2d(size(acc, 1), self%grid%node_count, acc, mom, frc, dt, self%mass_tolerance, v, dv)
+         else
+            call nodal_velocities_3d(size(acc, 1), self%grid%node_count, acc, mom, frc, dt, self%mass_tolerance, v, dv)
+         end if
          if (self%rigid%active) then
             ! rigid bodies first, on the increments before the walls: a body meets the walls as a body
             ! (rigid_bodies), and the walls then hold the other nodes only
@@ -607,6 +601,60 @@ contains
             dv = v - dv
          end if
       end associate
+
+   contains
+
+      ! dv := v^n = P/m (for now), v := v^{n+1} = v^n + dt f/m before the walls; 0 where m is below the
+      ! tolerance. Per dimension (with one routine and the dimension a literal at the calls, only the loop
+      ! over the components vectorised), the node's rows read before the test: so the 2-D loop vectorises
+      ! (with sections of run-time length read under the test it stayed scalar). The same operations as before.
+      pure subroutine nodal_velocities_2d(rows, n, acc, mom, frc, dt, tolerance, v, dv)
+         integer, intent(in) :: rows, n, mom, frc
+         real(rp), intent(in) :: acc(rows, n), dt, tolerance
+         real(rp), intent(inout) :: v(2, n), dv(2, n)
+         real(rp) :: m, momentum(2), force(2)
+         integer :: i, k
+         do i = 1, n
+            m = acc(row_mass, i)
+            momentum = acc(mom:mom + 1, i)     ! read whatever the mass: the loads need no mask
+            force = acc(frc:frc + 1, i)
+            if (m > tolerance) then
+               do k = 1, 2
+                  dv(k, i) = momentum(k) / m
+                  v(k, i) = dv(k, i) + dt * force(k) / m
+               end do
+            else
+               do k = 1, 2
+                  dv(k, i) = 0.0_rp
+                  v(k, i) = 0.0_rp
+               end do
+            end if
+         end do
+      end subroutine nodal_velocities_2d
+
+      pure subroutine nodal_velocities_3d(rows, n, acc, mom, frc, dt, tolerance, v, dv)
+         integer, intent(in) :: rows, n, mom, frc
+         real(rp), intent(in) :: acc(rows, n), dt, tolerance
+         real(rp), intent(inout) :: v(3, n), dv(3, n)
+         real(rp) :: m, momentum(3), force(3)
+         integer :: i, k
+         do i = 1, n
+            m = acc(row_mass, i)
+            momentum = acc(mom:mom + 2, i)     ! read whatever the mass: the loads need no mask
+            force = acc(frc:frc + 2, i)
+            if (m > tolerance) then
+               do k = 1, 3
+                  dv(k, i) = momentum(k) / m
+                  v(k, i) = dv(k, i) + dt * force(k) / m
+               end do
+            else
+               do k = 1, 3
+                  dv(k, i) = 0.0_rp
+                  v(k, i) = 0.0_rp
+               end do
+            end if
+         end do
+      end subroutine nodal_velocities_3d
    end subroutine update_nodes
 
    !> The rigid bodies' step (rigid_bodies): each moves with the rigid projection of the nodal increments of
@@ -765,12 +813,17 @@ contains
    !> apart (a maximum each over the ranks): c(rho_min) + max |v| of the whole material is then the same
    !> number on any rank count, which the largest per-rank sum c + |v| is not (the slowest density and the
    !> fastest particle may lie on different ranks).
-   subroutine local_speeds(self, speeds)
+   !> `motion`, `scanned`: the scans of the materials merged (the health check's velocities and densities),
+   !> and whether they cover every particle (not with a fixed step: it reads no densities).
+   subroutine local_speeds(self, speeds, motion, scanned)
       type(solver_t), intent(in) :: self
       real(rp), intent(out) :: speeds(:)
+      type(motion_scan_t), intent(out), optional :: motion
+      logical, intent(out), optional :: scanned
       integer :: m, first, last
-      real(rp) :: speed2, rho_min
+      type(motion_scan_t) :: scan
       speeds = 0.0_rp
+      if (present(scanned)) scanned = self%run%fixed_dt <= 0.0_rp
       do m = 1, size(self%materials)
          first = self%particles%material_first(m)
          last = self%particles%material_last(m)
@@ -778,10 +831,10 @@ contains
          if (self%run%fixed_dt > 0.0_rp) then
             speeds(2 * m) = sqrt(real(self%grid%dim, rp)) * maxval(abs(self%particles%v(:, first:last)))
          else
-            call fastest_and_lightest(self%particles%v(:, first:last), self%particles%density(first:last), &
-                                      speed2, rho_min)
-            speeds(2 * m - 1) = self%materials(m)%model%wave_speed(rho_min)
-            speeds(2 * m) = sqrt(speed2)
+            call scan_motion(self%particles%v(:, first:last), self%particles%density(first:last), scan)
+            speeds(2 * m - 1) = self%materials(m)%model%wave_speed(scan%lightest)
+            speeds(2 * m) = sqrt(scan%speed2)
+            if (present(motion)) call merge_motion_scans(motion, scan)
          end if
       end do
    end subroutine local_speeds
@@ -831,63 +884,6 @@ contains
          end do
       end subroutine divide_3d
    end subroutine momenta_to_velocities
-
-   !> The largest |v_p|^2 and the lowest density of a slice of particles (local_speeds), in loops the compiler
-   !> vectorises (one scalar loop for both was 4 % of a 2-D step; max and min are exact, so the order does
-   !> not matter). The speeds per dimension, the velocities of a known leading dimension; |v|^2 summed from
-   !> 0 as sum() does, so that the compiler fuses the same multiplications into its additions and the step
-   !> is the same bit for bit (v1^2 + v2^2 fused the other one). NaN densities counted in an integer (a
-   !> logical reduction keeps the loop scalar): a NaN density (the health check reports it) is passed over
-   !> as minval does, which a vectorised min need not do, so then a scalar pass.
-   pure subroutine fastest_and_lightest(v, density, speed2, rho_min)
-      real(rp), intent(in), contiguous :: v(:, :), density(:)
-      real(rp), intent(out) :: speed2, rho_min
-      integer :: n, p, nans
-      n = size(density)
-      if (size(v, 1) == 2) then
-         speed2 = largest_2d(v)
-      else
-         speed2 = largest_3d(v)
-      end if
-      rho_min = huge(1.0_rp)
-      nans = 0
-      do p = 1, n
-         rho_min = min(rho_min, density(p))
-         nans = nans + merge(1, 0, ieee_is_nan(density(p)))
-      end do
-      if (nans > 0) then
-         rho_min = huge(1.0_rp)
-         do p = 1, n
-            if (density(p) < rho_min) rho_min = density(p)
-         end do
-      end if
-   contains
-      pure real(rp) function largest_2d(v) result(largest)
-         real(rp), intent(in) :: v(2, n)
-         real(rp) :: v2
-         integer :: p
-         largest = 0.0_rp
-         do p = 1, n
-            v2 = 0.0_rp
-            v2 = v2 + v(1, p)**2
-            v2 = v2 + v(2, p)**2
-            largest = max(largest, v2)
-         end do
-      end function largest_2d
-      pure real(rp) function largest_3d(v) result(largest)
-         real(rp), intent(in) :: v(3, n)
-         real(rp) :: v2
-         integer :: p
-         largest = 0.0_rp
-         do p = 1, n
-            v2 = 0.0_rp
-            v2 = v2 + v(1, p)**2
-            v2 = v2 + v(2, p)**2
-            v2 = v2 + v(3, p)**2
-            largest = max(largest, v2)
-         end do
-      end function largest_3d
-   end subroutine fastest_and_lightest
 
    !> The stable step `dt` from the speeds of all ranks (local_speeds, reduced), and a bound `speed`
    !> [m/s] on how fast the particles move: the largest signal speed c + |v| of the materials and open
@@ -943,8 +939,9 @@ contains
       integer :: dim, need_lo(3), need_hi(3), box_lo(3), box_hi(3), target_lo(3), target_hi(3), guard, margin, n, flags
       integer :: cuts(0:self%domain%nranks, 3)
       integer(i8) :: largest
-      logical :: kept
+      logical :: kept, scanned, healthy
       type(status_t) :: status
+      type(motion_scan_t) :: motion
 
       dim = self%grid%dim
       ! all as minima: [lo(1:3), -hi(1:3), -speeds(:)] (local_speeds). The extent is that of the positions
@@ -956,12 +953,17 @@ contains
       allocate (values(n + flags))
       values(1:3) = self%extent(:, 1)
       values(4:6) = -self%extent(:, 2)
-      call local_speeds(self, values(7:n))
+      call local_speeds(self, values(7:n), motion, scanned)
       values(7:n) = -values(7:n)
       if (flags > 0) then
          call self%timers%switch_to(phase_health)
-         self%loop_flags(flag_unhealthy) = merge(0, 1, particles_healthy(self%particles, self%speed_limit, &
-                                                                         self%density_limits))
+         ! the velocities and densities as the step's scan found them: the check reads only the stresses
+         if (scanned) then
+            healthy = particles_healthy(self%particles, self%speed_limit, self%density_limits, motion)
+         else
+            healthy = particles_healthy(self%particles, self%speed_limit, self%density_limits)
+         end if
+         self%loop_flags(flag_unhealthy) = merge(0, 1, healthy)
          self%loop_flags(flag_no_memory) = merge(0, 1, self%particles%allocation%ok)
          ! maxima as minima of the negated (small integers: exact)
          values(n + 1:) = -real(self%loop_flags, rp)
