@@ -4,12 +4,13 @@
 !> A particle is unhealthy when a position, velocity, density or stress component is not finite, its
 !> density is not positive or lies outside the run's density limits (a factor of 100 around the
 !> materials' reference densities: a J that ran away at sane speeds), or its speed exceeds the run's
-!> speed limit. The check that runs every step
-!> reads velocity, density and stress once, as flat arrays, in 8 independent partial sums (so the loops
-!> vectorise without reordering the additions): a sum is finite only if every value is (a NaN or an
-!> infinity propagates through a sum; the finite values of a sane state cannot overflow it). Positions
-!> are not read: a position turns non-finite only with the velocity that moved it. Only when the check
-!> fails does a second pass look for the first bad particle to name it. [R]
+!> speed limit. The check that runs every step takes the velocities and densities from a scan of them
+!> (scan_motion: the largest |v|^2, the lowest and highest density, NaN counts), which the time step makes
+!> anyway and hands over, and reads the stresses once, as a flat array, in 8 independent partial sums (so
+!> the loop vectorises without reordering the additions): a sum is finite only if every value is (a NaN
+!> or an infinity propagates through a sum; the finite values of a sane state cannot overflow it).
+!> Positions are not read: a position turns non-finite only with the velocity that moved it. Only when the
+!> check fails does a second pass look for the first bad particle to name it. [R]
 module health_check
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
    use kinds, only: rp
@@ -40,90 +41,49 @@ module health_check
 contains
 
    !> True if every particle is healthy (see the module). `speed_limit` in m/s; `density_limits` the
-   !> lowest and highest density allowed [kg/m^3] (without: any positive density).
-   !> `motion`: the time step's scan of every particle's velocity and density (scan_motion, merged over the
-   !> materials); with it only the stresses are read here.
+   !> lowest and highest density allowed [kg/m^3] (without: any positive density). `motion`: the time
+   !> step's scan of every particle's velocity and density (scan_motion, merged over the materials); without
+   !> it they are scanned here.
    logical function particles_healthy(particles, speed_limit, density_limits, motion) result(healthy)
       type(particle_set_t), intent(in) :: particles
       real(rp), intent(in) :: speed_limit
       real(rp), intent(in), optional :: density_limits(2)
       type(motion_scan_t), intent(in), optional :: motion
-      real(rp) :: total, largest, smallest, densest
+      type(motion_scan_t) :: scan
+      real(rp) :: total
       integer :: n
       n = particles%count
       healthy = .true.
       if (n == 0) return
-      total = 0.0_rp
       if (present(motion)) then
-         call scan_values(particles%sbar, particles%n_sigma * n, total)
-         ! |v|^2 is finite only if every component is: an infinity makes it infinite, a NaN is counted
-         healthy = ieee_is_finite(total) .and. motion%nan_speeds == 0 .and. motion%nan_densities == 0 .and. &
-                   ieee_is_finite(motion%speed2) .and. ieee_is_finite(motion%densest) .and. motion%lightest > 0.0_rp
-         if (healthy .and. present(density_limits)) healthy = motion%lightest >= density_limits(1) .and. &
-                                                              motion%densest <= density_limits(2)
-         if (healthy) healthy = sqrt(motion%speed2) <= speed_limit     ! the limit may be huge: not squared
-         return
+         scan = motion
+      else
+         call scan_motion(particles%v(:, 1:n), particles%density(1:n), scan)
       end if
-      largest = 0.0_rp
-      smallest = huge(1.0_rp)
-      densest = 0.0_rp
-      call scan_values(particles%v, particles%dim * n, total, largest=largest)
-      call scan_values(particles%density, n, total, largest=densest, smallest=smallest)
-      call scan_values(particles%sbar, particles%n_sigma * n, total)
-      if (.not. ieee_is_finite(total)) then
-         healthy = .false.
-         return
-      end if
-      ! every value is finite from here. |v| <= sqrt(dim) max_k |v_k|: look closer only near the limit
-      healthy = smallest > 0.0_rp
-      if (present(density_limits)) healthy = healthy .and. smallest >= density_limits(1) .and. &
-                                             densest <= density_limits(2)
-      if (healthy .and. sqrt(real(particles%dim, rp)) * largest > speed_limit) &
-         healthy = maxval(sum(particles%v(:, 1:n)**2, dim=1)) <= speed_limit**2
+      total = stress_sum(particles%sbar, particles%n_sigma * n)
+      ! |v|^2 is finite only if every component is: an infinity makes it infinite, a NaN is counted
+      healthy = ieee_is_finite(total) .and. scan%nan_speeds == 0 .and. scan%nan_densities == 0 .and. &
+                ieee_is_finite(scan%speed2) .and. ieee_is_finite(scan%densest) .and. scan%lightest > 0.0_rp
+      if (healthy .and. present(density_limits)) healthy = scan%lightest >= density_limits(1) .and. &
+                                                           scan%densest <= density_limits(2)
+      if (healthy) healthy = sqrt(scan%speed2) <= speed_limit     ! the limit may be huge: not squared
    end function particles_healthy
 
-   !> Add the first n values of `values` to `total`; track their largest magnitude or smallest value.
-   !> Explicit shape: the arrays of the particle set are passed whole, as their first n elements.
-   pure subroutine scan_values(values, n, total, largest, smallest)
+   !> The sum of the first n values of `values` (8 partial sums). Explicit shape: the stresses of the
+   !> particle set are passed whole, as their first n elements.
+   pure real(rp) function stress_sum(values, n) result(total)
       integer, intent(in) :: n
       real(rp), intent(in) :: values(n)
-      real(rp), intent(inout) :: total
-      real(rp), intent(inout), optional :: largest, smallest
       integer, parameter :: width = 8
-      real(rp) :: sums(width), high(width), low(width)
+      real(rp) :: sums(width)
       integer :: i, tail
       tail = n - mod(n, width)
       sums = 0.0_rp
-      high = 0.0_rp
-      low = huge(1.0_rp)
-      ! one loop per case, so that each array is read once
-      if (present(largest) .and. present(smallest)) then
-         do i = 1, tail, width
-            sums = sums + values(i:i + width - 1)
-            high = max(high, abs(values(i:i + width - 1)))
-            low = min(low, values(i:i + width - 1))
-         end do
-         largest = max(largest, maxval(high), maxval(abs(values(tail + 1:n)), mask=n > tail))
-         smallest = min(smallest, minval(low), minval(values(tail + 1:n), mask=n > tail))
-      else if (present(largest)) then
-         do i = 1, tail, width
-            sums = sums + values(i:i + width - 1)
-            high = max(high, abs(values(i:i + width - 1)))
-         end do
-         largest = max(largest, maxval(high), maxval(abs(values(tail + 1:n)), mask=n > tail))
-      else if (present(smallest)) then
-         do i = 1, tail, width
-            sums = sums + values(i:i + width - 1)
-            low = min(low, values(i:i + width - 1))
-         end do
-         smallest = min(smallest, minval(low), minval(values(tail + 1:n), mask=n > tail))
-      else
-         do i = 1, tail, width
-            sums = sums + values(i:i + width - 1)
-         end do
-      end if
-      total = total + sum(sums) + sum(values(tail + 1:n))
-   end subroutine scan_values
+      do i = 1, tail, width
+         sums = sums + values(i:i + width - 1)
+      end do
+      total = sum(sums) + sum(values(tail + 1:n))
+   end function stress_sum
 
    !> The scan of velocities v(:, p) and densities density(p) of a slice of particles, in loops the compiler
    !> vectorises (one scalar loop for both was 4 % of a 2-D step). The velocities of a known leading

@@ -813,28 +813,26 @@ contains
    !> apart (a maximum each over the ranks): c(rho_min) + max |v| of the whole material is then the same
    !> number on any rank count, which the largest per-rank sum c + |v| is not (the slowest density and the
    !> fastest particle may lie on different ranks).
-   !> `motion`, `scanned`: the scans of the materials merged (the health check's velocities and densities),
-   !> and whether they cover every particle (not with a fixed step: it reads no densities).
-   subroutine local_speeds(self, speeds, motion, scanned)
+   !> `motion`: the materials' scans merged, for the health check (made with a fixed step too, for it).
+   subroutine local_speeds(self, speeds, motion)
       type(solver_t), intent(in) :: self
       real(rp), intent(out) :: speeds(:)
       type(motion_scan_t), intent(out), optional :: motion
-      logical, intent(out), optional :: scanned
       integer :: m, first, last
       type(motion_scan_t) :: scan
       speeds = 0.0_rp
-      if (present(scanned)) scanned = self%run%fixed_dt <= 0.0_rp
       do m = 1, size(self%materials)
          first = self%particles%material_first(m)
          last = self%particles%material_last(m)
          if (last < first) cycle
+         if (self%run%fixed_dt <= 0.0_rp .or. present(motion)) &
+            call scan_motion(self%particles%v(:, first:last), self%particles%density(first:last), scan)
+         if (present(motion)) call merge_motion_scans(motion, scan)
          if (self%run%fixed_dt > 0.0_rp) then
             speeds(2 * m) = sqrt(real(self%grid%dim, rp)) * maxval(abs(self%particles%v(:, first:last)))
          else
-            call scan_motion(self%particles%v(:, first:last), self%particles%density(first:last), scan)
             speeds(2 * m - 1) = self%materials(m)%model%wave_speed(scan%lightest)
             speeds(2 * m) = sqrt(scan%speed2)
-            if (present(motion)) call merge_motion_scans(motion, scan)
          end if
       end do
    end subroutine local_speeds
@@ -939,7 +937,7 @@ contains
       integer :: dim, need_lo(3), need_hi(3), box_lo(3), box_hi(3), target_lo(3), target_hi(3), guard, margin, n, flags
       integer :: cuts(0:self%domain%nranks, 3)
       integer(i8) :: largest
-      logical :: kept, scanned, healthy
+      logical :: kept
       type(status_t) :: status
       type(motion_scan_t) :: motion
 
@@ -953,17 +951,13 @@ contains
       allocate (values(n + flags))
       values(1:3) = self%extent(:, 1)
       values(4:6) = -self%extent(:, 2)
-      call local_speeds(self, values(7:n), motion, scanned)
+      call local_speeds(self, values(7:n), motion)
       values(7:n) = -values(7:n)
       if (flags > 0) then
          call self%timers%switch_to(phase_health)
          ! the velocities and densities as the step's scan found them: the check reads only the stresses
-         if (scanned) then
-            healthy = particles_healthy(self%particles, self%speed_limit, self%density_limits, motion)
-         else
-            healthy = particles_healthy(self%particles, self%speed_limit, self%density_limits)
-         end if
-         self%loop_flags(flag_unhealthy) = merge(0, 1, healthy)
+         self%loop_flags(flag_unhealthy) = merge(0, 1, particles_healthy(self%particles, self%speed_limit, &
+                                                                         self%density_limits, motion))
          self%loop_flags(flag_no_memory) = merge(0, 1, self%particles%allocation%ok)
          ! maxima as minima of the negated (small integers: exact)
          values(n + 1:) = -real(self%loop_flags, rp)
