@@ -60,7 +60,7 @@ module scene_description
       integer :: checkpoints_kept = 2         !< newest checkpoints kept on disk
       real(rp) :: speed_limit = 0.0_rp        !< particle speed taken as a blow-up [m/s]; 0: 10 x fastest wave
       !> rebalance when the largest rank holds more than this multiple of the mean particles per rank; 0: never
-      real(rp) :: rebalance_threshold = 1.1_rp
+      real(rp) :: rebalance_threshold = 1.02_rp
       integer :: rebalance_interval = 20      !< steps between balance checks (also at every output time)
       !> simulated time between rows of loads.csv, gauges.csv and bodies.csv [s]; 0: every step. Loads are
       !> averages over the interval (impulse / length), gauges and body states samples at the row's time.

@@ -59,6 +59,7 @@ module checkpoint
       real(rp) :: time = 0.0_rp, dt = 0.0_rp, mass_tolerance = 0.0_rp, next_output_time = 0.0_rp
       integer(i8) :: step = 0
       integer(i8) :: total = 0                    !< particles written
+      integer(i8) :: unimproved_largest = 0       !< solver%unimproved_largest (same decomposition only)
       integer :: ranks_written = 1
       integer(i8), allocatable :: rank_counts(:), lost(:), corrections(:)   !< per rank written
       logical :: same_decomposition = .false.     !< written on as many ranks as read: cuts holds its layout
@@ -108,6 +109,7 @@ contains
       call file%write_attribute('dt', solver%dt, status)
       call file%write_attribute('mass_tolerance', solver%mass_tolerance, status)
       call file%write_attribute('next_output_time', progress%next_output_time, status)
+      call file%write_attribute('unimproved_largest', solver%unimproved_largest, status)
       ! program, date and the resolved scene a restart compares with (its `ranks` is above)
       call write_provenance_attributes(file, solver%scene, agreed_date(solver%domain%comm), status)
       call write_particles(solver, file, status)
@@ -333,6 +335,9 @@ contains
       call file%read_attribute('dt', state%dt, status)
       call file%read_attribute('mass_tolerance', state%mass_tolerance, status)
       call file%read_attribute('next_output_time', state%next_output_time, status)
+      ! the load balancing's memory of a fruitless layout search (absent in files of before 2026-11-27: none)
+      if (file%has_attribute('unimproved_largest')) &
+         call file%read_attribute('unimproved_largest', state%unimproved_largest, status)
       call file%read_attribute('sequence', progress%checkpoints_written, status)
       call file%read_attribute('ranks', state%ranks_written, status)
       call file%read_attribute('particles', state%total, status)
@@ -432,6 +437,7 @@ contains
       solver%dt = state%dt
       solver%mass_tolerance = state%mass_tolerance
       if (state%same_decomposition) then
+         solver%unimproved_largest = state%unimproved_largest
          solver%lost_particles = int(state%lost(rank + 1))
          solver%wall_corrections = int(state%corrections(rank + 1))
          ! keep each rank's order: the continued run is then bitwise identical to an uninterrupted one

@@ -7,7 +7,7 @@ module particle_sorting
    implicit none
    private
 
-   public :: sort_by_material_and_cell, update_cells, set_material_ranges
+   public :: sort_by_material_and_cell, update_cells, set_material_ranges, in_material_order
 
 contains
 
@@ -91,4 +91,20 @@ contains
       end do
    end subroutine set_material_ranges
 
+   !> True if the particles after `sorted` (those appended to a set in material order, e.g. the arrivals
+   !> of a migration) keep it in material order: each is of the same material as the one before it or a
+   !> later one. Then every material's particles are still contiguous and set_material_ranges finds their
+   !> slices without a sort.
+   pure logical function in_material_order(particles, sorted)
+      type(particle_set_t), intent(in) :: particles
+      integer, intent(in) :: sorted
+      integer :: p
+      in_material_order = .true.
+      do p = max(2, sorted + 1), particles%count
+         if (particles%material(p) < particles%material(p - 1)) then
+            in_material_order = .false.
+            return
+         end if
+      end do
+   end function in_material_order
 end module particle_sorting

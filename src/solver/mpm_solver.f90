@@ -28,7 +28,7 @@ module mpm_solver
    use tensor_layout, only: n_spin
    use particle_seeding, only: seed_bodies
    use body_lattice, only: scene_id_count
-   use particle_sorting, only: sort_by_material_and_cell, update_cells, set_material_ranges
+   use particle_sorting, only: sort_by_material_and_cell, update_cells, set_material_ranges, in_material_order
    use particle_migration, only: migrate_particles
    use material_model, only: material_slot_t
    use material_factory, only: build_materials
@@ -95,6 +95,10 @@ module mpm_solver
       type(stencil_cache_t) :: stencils        !< the particles' stencils from P2G to G2P of a step (3-D)
       real(rp) :: extent(3, 2) = 0.0_rp         !< lowest and highest particle position after the last move
       integer :: relayouts = 0                  !< layouts made because the particles outgrew the active region
+      !> the largest rank's particle count when the last layout search found no better layout (0: none since
+      !> the layout last changed); kept in checkpoints, so a restart searches when the run it continues would
+      integer(i8) :: unimproved_largest = 0
+      integer :: layout_searches = 0            !< layout searches of the load balancing (this run)
       !> the time loop's flags, carried by the step's one reduction (follow_particles) instead of a reduction
       !> of their own: the caller sets its flags (from index 3) before advance, advance sets flag_unhealthy
       !> (with the limits below) and flag_no_memory and leaves the maxima over the ranks. Unallocated: none.
@@ -317,19 +321,34 @@ contains
 
    !> Rebalance if the largest rank holds more than rebalance_threshold times the mean number of
    !> particles per rank and another layout lowers that largest count (docs/theory.md section 6).
-   !> Between steps only. Collective: one gather of the counts; the layout search only when unbalanced.
+   !> A search that found no better layout is repeated only once the largest count has grown by the
+   !> unbalance the threshold allows ((threshold - 1) times the mean) or the layout changed: in a scene
+   !> no layout balances better (particles in fewer layers than the ranks need) the search, a pass over
+   !> the particles per rank grid, would else run at every check. Between steps only. Collective: one
+   !> gather of the counts; the layout search only when unbalanced.
    subroutine solver_balance_load(self, status)
       class(solver_t), intent(inout) :: self
       type(status_t), intent(inout) :: status
       integer(i8) :: counts(self%domain%nranks), largest
       integer :: cuts(0:self%domain%nranks, 3)
+      real(rp) :: total, allowed
       if (self%domain%nranks == 1 .or. self%run%rebalance_threshold <= 0.0_rp) return
       call MPI_Allgather(int(self%particles%count, i8), 1, MPI_INTEGER8, counts, 1, MPI_INTEGER8, self%domain%comm)
       call count_collective(comm_balance, self%domain%nranks, int8_bytes)
-      if (real(maxval(counts), rp) * self%domain%nranks <= self%run%rebalance_threshold * real(sum(counts), rp)) return
+      ! in units of the mean count: the largest count, and what the threshold allows
+      total = real(sum(counts), rp)
+      allowed = self%run%rebalance_threshold * total
+      if (real(maxval(counts), rp) * self%domain%nranks <= allowed) return
+      if (self%unimproved_largest > 0) then
+         if (real(maxval(counts) - self%unimproved_largest, rp) * self%domain%nranks <= allowed - total) return
+      end if
+      self%layout_searches = self%layout_searches + 1
       call balanced_layout(self%domain, self%grid, self%particles, cuts, largest)
-      ! no better layout (particles packed in fewer layers than the ranks need): keep this one
-      if (largest < maxval(counts)) call self%set_layout(cuts, status)
+      if (largest < maxval(counts)) then
+         call self%set_layout(cuts, status)
+      else
+         self%unimproved_largest = maxval(counts)     ! no better layout: keep this one
+      end if
    end subroutine solver_balance_load
 
    !> Adopt the decomposition `cuts` (as domain%cuts; the rank grid and the active region may change): the
@@ -352,6 +371,7 @@ contains
       end do
       if (present(moved)) same_owners = same_owners .and. .not. moved
       call self%domain%set_layout(cuts)
+      self%unimproved_largest = 0      ! a new layout: the balance check may search again
       if (.not. same_owners) then
          call redistribute_particles(self%domain, self%grid, self%particles, status)
          if (.not. status%ok) return
@@ -520,9 +540,13 @@ contains
       call self%timers%switch_to(phase_migration)
       call migrate_particles(self%domain, self%grid, self%particles, self%lost_particles, arrived)
       call self%timers%switch_to(phase_sort)
-      ! arrivals and new particles are appended at the end: re-sort so materials stay contiguous;
-      ! otherwise re-sort now and then for memory locality (removals keep the grouping of the rest)
-      if (arrived > 0 .or. created > 0 .or. mod(self%step + 1, int(sort_interval, i8)) == 0) then
+      ! arrivals and new particles are appended at the end: re-sort where that would split a material's
+      ! particles (or any particle was created); otherwise re-sort now and then for memory locality
+      ! (removals keep the grouping of the rest). Arrivals that keep the materials in order (one material)
+      ! wait for that periodic sort: out of cell order meanwhile, they change only the order of sums (the
+      ! receiving rank sorted its whole set at every step in which a particle crossed)
+      if (created > 0 .or. mod(self%step + 1, int(sort_interval, i8)) == 0 .or. &
+          .not. in_material_order(self%particles, self%particles%count - arrived)) then
          call sort_by_material_and_cell(self%grid, self%particles)
       else
          call set_material_ranges(self%particles)

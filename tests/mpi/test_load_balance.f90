@@ -3,7 +3,8 @@
 !> rebalance_interval steps). The diagnostics agree to round-off (relative 1e-10, as between rank
 !> counts: only the order of the particle-grid sums changes), the layout did change, and afterwards the
 !> largest rank holds at most 60 % of the particles on 2 ranks (a lower share than without on more).
-!> Without rebalancing the slabs of the active region keep their inner cuts (section 6.2).
+!> Without rebalancing the slabs of the active region keep their inner cuts (section 6.2). A layout search
+!> that finds no better layout is not repeated at every check while the counts stay.
 module test_load_balance
    use kinds, only: rp, i8
    use mpi_f08, only: MPI_Comm, MPI_Comm_size
@@ -13,12 +14,13 @@ module test_load_balance
    use mpm_solver, only: solver_t
    use run_diagnostics, only: diagnostics_t
    use input_text, only: real_text
-   use test_scenes, only: tank_with_inlet, corner_column
+   use test_scenes, only: tank_with_inlet, corner_column, water_scene, add_body
    use time_loop_steps, only: start_run, step_run
    implicit none
    private
 
    public :: test_collapsing_column_rebalanced, test_apic_column_rebalanced, test_filling_tank_rebalanced
+   public :: test_fruitless_search_not_repeated
 
    integer, parameter :: n_steps = 200
 
@@ -64,6 +66,45 @@ contains
       scene%inlets(1)%hydrostatic = .true.
       call compare_with_and_without(comm, scene, 'filling tank')
    end subroutine test_filling_tank_rebalanced
+
+   !> A block of water at rest (no gravity) 3 x 3 cells in the middle of the box: the cell layers cannot be
+   !> shared evenly (on 2 ranks the best split holds 2 of the 3 layers, a share of 2/3), so every balance
+   !> check finds the ranks unbalanced. The first search takes the best layout, the next finds none better;
+   !> after that, with the counts unchanged, the checks must not search again (before, each of the 10
+   !> checks of 200 steps made a search: a pass over the particles per rank grid).
+   subroutine test_fruitless_search_not_repeated(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(scene_t) :: scene
+      type(solver_t) :: solver
+      type(status_t) :: status
+      integer :: nranks, step, searches_after_start
+      call MPI_Comm_size(comm, nranks)
+      scene = water_scene(2, 0.05_rp, [2.0_rp, 2.0_rp, 0.0_rp], 2.0e6_rp, 0.0_rp)
+      call add_body(scene, 1, [0.9_rp, 0.9_rp, 0.0_rp], [1.05_rp, 1.05_rp, 0.0_rp], 2, .false., 0.0_rp)
+      scene%run%fixed_dt = 1.0e-4_rp
+      call start_run(solver, scene, comm, status)
+      call assertTrue(status%ok, 'solver init: '//trim(status%message))
+      searches_after_start = solver%layout_searches
+      do step = 1, n_steps
+         call step_run(solver, status)
+      end do
+      call assertTrue(status%ok, 'balance: '//trim(status%message))
+      associate (diag => solver%diagnostics())
+         call assertEqual(diag%particles, 36_i8, 'the block: 3 x 3 cells of 4 particles')
+         if (nranks == 1) then
+            call assertEqual(solver%layout_searches, 0, 'one rank: no search')
+         else
+            call assertTrue(diag%max_rank_share > 1.02_rp / nranks, 'the block cannot be balanced, share '// &
+                            real_text(diag%max_rank_share))
+            if (nranks == 2) call assertRelativelyEqual(diag%max_rank_share, 2.0_rp / 3.0_rp, 1.0e-12_rp, &
+                                                        'the best split: 2 of 3 layers')
+            call assertTrue(solver%unimproved_largest > 0_i8, 'the last search found no better layout')
+            call assertTrue(solver%layout_searches <= searches_after_start + 1, 'at most one search after the start '// &
+                            'in 10 checks with unchanged counts: '//real_text(real(solver%layout_searches, rp)))
+         end if
+      end associate
+      call solver%free()
+   end subroutine test_fruitless_search_not_repeated
 
    subroutine compare_with_and_without(comm, scene, label)
       type(MPI_Comm), intent(in) :: comm
