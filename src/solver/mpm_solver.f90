@@ -47,7 +47,7 @@ module mpm_solver
    use rigid_bodies, only: rigid_set_t
    use world_frame, only: frame_t, place_grid
    use grid_transfer, only: particles_to_grid, update_velocity_and_remap, grid_to_particles
-   use stencil_cache, only: stencil_cache_t, forget_stencils, forget_weights
+   use stencil_cache, only: stencil_cache_t, forget_stencils
    use run_diagnostics, only: diagnostics_t, compute_diagnostics
    use active_region, only: scene_extent, particle_extent, cells_of_extent, guard_cells, box_needs_change, target_box, &
                             slack_cells
@@ -513,7 +513,6 @@ contains
          call set_slice(m)
          call self%schemes(m)%scheme%filter_stress(context, self%particles)
       end do
-      call forget_weights(self%stencils)      ! NB's shape values at x^n: the sort below may reorder
       if (self%volume%relaxing) then
          call self%timers%switch_to(phase_volume_correction)
          call self%volume%relax_pressure(self%particles)

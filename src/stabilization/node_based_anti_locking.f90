@@ -10,20 +10,14 @@
 !> Cost (docs/performance.md, "NB"): the particle loops are node_based_kernels' compile-time instances;
 !> the work arrays are kept from step to step (they only grow); and when the material's particles are
 !> all the particles (context%sole_material) m_i is the grid's mass row of the step's P2G, the same sum
-!> in the same order, so `prepare` neither sums nor exchanges the masses again. On 2-D multilinear grids
-!> the step's P2G keeps the base nodes and N_ip for NB in the stencil cache (NB asks for them by its
-!> keep_weights, from its first step on), so `prepare` evaluates and stores nothing either: the same
-!> values, bit for bit. (In 3-D `prepare` evaluates them from the cached positions in cells.)
+!> in the same order, so `prepare` neither sums nor exchanges the masses again.
 module node_based_anti_locking
    use kinds, only: rp
    use particle_set, only: particle_set_t
    use stabilizer, only: stabilizer_t, stage_context_t
    use background_grid, only: grid_t, row_mass
    use node_halo, only: sum_shared_nodes
-   use node_based_kernels, only: store_shape_values, nodal_masses, scatter_to_nodes, gather_from_nodes, divide_by_mass, &
-                                 clear
-   use stencil_cache, only: holds_weights
-   use shape_functions, only: shape_bspline2
+   use node_based_kernels, only: store_shape_values, scatter_to_nodes, gather_from_nodes, divide_by_mass, clear
    implicit none
    private
 
@@ -33,8 +27,6 @@ module node_based_anti_locking
       real(rp), allocatable :: nodal_mass(:, :)  !< m_i of this material, summed over ranks (1, node; if own_mass)
       real(rp), allocatable :: nodal(:, :)       !< the projected values (components, node)
       logical :: own_mass = .true.               !< m_i is nodal_mass, else the grid's mass row
-      logical :: cached = .false.                !< this step's stencils are P2G's, in context%stencils
-      logical :: ask_for_weights = .true.        !< P2G has not yet been found not to keep them (this kernel)
    contains
       procedure :: prepare => nb_prepare
       procedure :: filter_strain_rate => nb_filter_strain_rate
@@ -43,19 +35,13 @@ module node_based_anti_locking
 
 contains
 
-   !> Shape values at x^n (P2G's, or evaluated here) and the material's nodal masses.
+   !> Shape values at x^n and the material's nodal masses.
    subroutine nb_prepare(self, context, particles)
       class(node_based_anti_locking_t), intent(inout) :: self
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
       integer :: n
 
-      self%cached = use_cached_weights(context, particles, self%ask_for_weights)
-      if (self%cached) then
-         if (allocated(self%base)) deallocate (self%base, self%weight)
-         call nodal_mass_of_material(self, context, particles)
-         return
-      end if
       associate (grid => context%grid)
          n = max(0, context%last - context%first + 1)
          if (allocated(self%base)) then
@@ -81,50 +67,6 @@ contains
       end associate
    end subroutine nb_prepare
 
-   !> Whether this step's P2G kept the stencils of the whole set for NB. Asks for them from the next step
-   !> on where the grid is 2-D multilinear; where P2G does not keep them after all (contact's fields) it
-   !> stops asking for good (`ask` false), and the cache frees their room.
-   logical function use_cached_weights(context, particles, ask) result(cached)
-      type(stage_context_t), intent(in) :: context
-      type(particle_set_t), intent(in) :: particles
-      logical, intent(inout) :: ask
-      cached = .false.
-      if (.not. associated(context%stencils)) return
-      associate (stencils => context%stencils)
-         cached = holds_weights(stencils, particles%count)
-         if (stencils%keep_weights .and. .not. cached) then     ! asked before, not kept: not this kernel
-            ask = .false.
-            stencils%keep_weights = .false.
-            if (allocated(stencils%weight)) deallocate (stencils%weight)
-         else if (ask .and. .not. stencils%keep_weights .and. context%grid%dim == 2 .and. &
-                  context%grid%shape /= shape_bspline2 .and. particles%n_affine == 0) then
-            stencils%keep_weights = .true.
-         end if
-      end associate
-   end function use_cached_weights
-
-   !> m_i of the material from P2G's stencils (own_mass: other materials share the grid), summed over ranks.
-   subroutine nodal_mass_of_material(self, context, particles)
-      type(node_based_anti_locking_t), intent(inout) :: self
-      type(stage_context_t), intent(in) :: context
-      type(particle_set_t), intent(in) :: particles
-      integer :: first, last
-      self%own_mass = .not. context%sole_material
-      if (.not. self%own_mass) return
-      first = context%first
-      last = context%last
-      if (allocated(self%nodal_mass)) then
-         if (size(self%nodal_mass, 2) < context%grid%node_count) deallocate (self%nodal_mass)
-      end if
-      if (.not. allocated(self%nodal_mass)) allocate (self%nodal_mass(1, context%grid%node_count))
-      associate (mass => self%nodal_mass(:, 1:context%grid%node_count))
-         mass = 0.0_rp
-         if (last >= first) call nodal_masses(context%grid, context%stencils%base(first:last), &
-                                              context%stencils%weight(:, first:last), particles%mass(first:last), mass(1, :))
-         call sum_shared_nodes(context%domain, context%grid, mass)
-      end associate
-   end subroutine nodal_mass_of_material
-
    subroutine nb_filter_strain_rate(self, context, particles)
       class(node_based_anti_locking_t), intent(inout) :: self
       type(stage_context_t), intent(in) :: context
@@ -137,11 +79,6 @@ contains
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
       call project_and_interpolate(self, context, particles, particles%sbar(:, context%first:context%last))
-      ! asked for P2G's shape values from the next step on: free the own ones now, so that the two are not
-      ! held at once when P2G sizes its room (the peak memory of the run)
-      if (.not. self%cached .and. associated(context%stencils)) then
-         if (context%stencils%keep_weights .and. allocated(self%base)) deallocate (self%base, self%weight)
-      end if
    end subroutine nb_filter_stress
 
    !> values(:, q) := sum_i N_iq (sum_r N_ir m_r values_r / m_i) for the material's slice (values(:, q)
@@ -161,26 +98,15 @@ contains
       end if
       if (.not. allocated(self%nodal)) allocate (self%nodal(size(values, 1), nodes))
       call clear(size(values, 1) * nodes, self%nodal)
-      associate (nodal => self%nodal(:, 1:nodes), first => context%first, last => context%last)
-         if (self%cached) then
-            if (last >= first) call scatter_to_nodes(grid, context%stencils%base(first:last), &
-                                                     context%stencils%weight(:, first:last), particles%mass(first:last), &
-                                                     values, nodal)
-         else
-            call scatter_to_nodes(grid, self%base, self%weight, particles%mass(first:last), values, nodal)
-         end if
+      associate (nodal => self%nodal(:, 1:nodes))
+         call scatter_to_nodes(grid, self%base, self%weight, particles%mass(context%first:context%last), values, nodal)
          call sum_shared_nodes(context%domain, grid, nodal)
          if (self%own_mass) then
             call divide_by_mass(grid, self%nodal_mass(1, 1:nodes), nodal)
          else
             call divide_by_mass(grid, grid%accumulated(row_mass, 1:nodes), nodal)
          end if
-         if (self%cached) then
-            if (last >= first) call gather_from_nodes(grid, context%stencils%base(first:last), &
-                                                      context%stencils%weight(:, first:last), nodal, values)
-         else
-            call gather_from_nodes(grid, self%base, self%weight, nodal, values)
-         end if
+         call gather_from_nodes(grid, self%base, self%weight, nodal, values)
       end associate
    end subroutine project_and_interpolate
 end module node_based_anti_locking

@@ -12,7 +12,7 @@ module node_based_kernels
    implicit none
    private
 
-   public :: store_shape_values, nodal_masses, scatter_to_nodes, gather_from_nodes, divide_by_mass, clear
+   public :: store_shape_values, scatter_to_nodes, gather_from_nodes, divide_by_mass, clear
 
 contains
 
@@ -40,20 +40,6 @@ contains
       case default; call store_b2_3d(grid, particles, first, last, base, weight, mass, stencils)
       end select
    end subroutine store_shape_values
-
-   !> nodal_mass(i) += sum_q N_iq particle_mass(q), the stencils base(q), weight(:, q) given (P2G's).
-   subroutine nodal_masses(grid, base, weight, particle_mass, nodal_mass)
-      type(grid_t), intent(in) :: grid
-      integer, intent(in), contiguous :: base(:)
-      real(rp), intent(in), contiguous :: weight(:, :), particle_mass(:)
-      real(rp), intent(inout), contiguous :: nodal_mass(:)
-      select case (instance(grid))
-      case (1); call masses_2d(grid, base, weight, particle_mass, nodal_mass)
-      case (2); call masses_3d(grid, base, weight, particle_mass, nodal_mass)
-      case (3); call masses_b2_2d(grid, base, weight, particle_mass, nodal_mass)
-      case default; call masses_b2_3d(grid, base, weight, particle_mass, nodal_mass)
-      end select
-   end subroutine nodal_masses
 
    !> nodal(:, i) += sum_q N_iq mass(q) values(:, q) (the stencils stored by store_shape_values).
    subroutine scatter_to_nodes(grid, base, weight, mass, values, nodal)
@@ -110,7 +96,6 @@ contains
 #define SHAPE shape_2d
 #define BASE base_linear
 #define STORE store_2d
-#define MASSES masses_2d
 #define SCATTER scatter_2d
 #define GATHER gather_2d
 #define DIVIDE divide_2d
@@ -123,7 +108,6 @@ contains
 #define SHAPE shape_3d
 #define BASE base_linear
 #define STORE store_3d
-#define MASSES masses_3d
 #define SCATTER scatter_3d
 #define GATHER gather_3d
 #define DIVIDE divide_3d
@@ -136,7 +120,6 @@ contains
 #define SHAPE bspline2_2d
 #define BASE base_bspline2
 #define STORE store_b2_2d
-#define MASSES masses_b2_2d
 #define SCATTER scatter_b2_2d
 #define GATHER gather_b2_2d
 #define DIVIDE divide_b2_2d
@@ -149,7 +132,6 @@ contains
 #define SHAPE bspline2_3d
 #define BASE base_bspline2
 #define STORE store_b2_3d
-#define MASSES masses_b2_3d
 #define SCATTER scatter_b2_3d
 #define GATHER gather_b2_3d
 #define DIVIDE divide_b2_3d

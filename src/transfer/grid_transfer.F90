@@ -11,7 +11,7 @@ module grid_transfer
    use background_grid, only: grid_t, row_mass
    use shape_functions, only: shape_bspline2
    use particle_set, only: particle_set_t
-   use stencil_cache, only: stencil_cache_t, size_stencil_cache, holds_stencils, forget_stencils, forget_weights
+   use stencil_cache, only: stencil_cache_t, size_stencil_cache, holds_stencils, forget_stencils
    implicit none
    private
 
@@ -45,8 +45,7 @@ contains
    !> mass gradient sum m_p grad N_i in its rows of grid%accumulated from `field_row` on (field(p) = 0: the
    !> common field, only in the totals).
    !> With `stencils` (3-D): each particle's stencil is kept there for the later passes of the same step
-   !> (src/transfer/stencil_cache.f90); with its keep_weights also the base node and shape values for NB,
-   !> by the 2-D multilinear single-field FLIP/PIC kernel (with the others NB evaluates them itself).
+   !> (src/transfer/stencil_cache.f90).
    subroutine particles_to_grid(grid, particles, gravity, field, field_row, stencils)
       type(grid_t), intent(inout) :: grid
       type(particle_set_t), intent(in) :: particles
@@ -56,9 +55,8 @@ contains
       grid%accumulated = 0.0_rp
       if (present(stencils)) then
          call forget_stencils(stencils)
-         call forget_weights(stencils)
          ! only the 3-D kernels keep stencils: the 2-D ones locate a block of particles at a time, vectorised
-         call size_stencil_cache(stencils, size(particles%mass), grid%dim, grid%stencil_size)
+         if (grid%dim == 3) call size_stencil_cache(stencils, size(particles%mass))
       end if
       if (present(field)) then
          select case (transfer_instance(grid, particles))
@@ -76,7 +74,7 @@ contains
          end select
       else
          select case (transfer_instance(grid, particles))
-         case (kernels_linear_2d); call particles_to_grid_2d(grid, particles, gravity, stencils)
+         case (kernels_linear_2d); call particles_to_grid_2d(grid, particles, gravity)
          case (kernels_linear_3d); call particles_to_grid_3d(grid, particles, gravity, stencils)
          case (kernels_bspline2_2d); call particles_to_grid_b2_2d(grid, particles, gravity)
          case (kernels_bspline2_3d); call particles_to_grid_b2_3d(grid, particles, gravity, stencils)
@@ -88,8 +86,6 @@ contains
       end if
       if (present(stencils)) then
          if (grid%dim == 3) stencils%count = particles%count
-         if (stencils%keep_weights .and. .not. present(field) .and. transfer_instance(grid, particles) == kernels_linear_2d) &
-            stencils%weights_count = particles%count
       end if
    end subroutine particles_to_grid
 

@@ -2,8 +2,7 @@
 !> particle's base node and position in cells, the re-map and G2P of the same step read them instead of
 !> locating the particle again. With and without the cache every transfer must give the same bits; a cache
 !> that no longer matches the particles must not be read (forgotten, or of another particle count), and a
-!> stale one that is read must show (so the cached path is the one these comparisons run). Asked to keep
-!> the shape values (NB's), the multilinear FLIP/PIC P2G keeps exactly what NB would evaluate itself.
+!> stale one that is read must show (so the cached path is the one these comparisons run).
 module test_stencil_cache
    use kinds, only: rp
    use mpi_f08, only: MPI_Comm
@@ -12,14 +11,13 @@ module test_stencil_cache
    use scene_description, only: scene_t
    use mpm_solver, only: solver_t
    use grid_transfer, only: particles_to_grid, update_velocity_and_remap, grid_to_particles
-   use stencil_cache, only: stencil_cache_t, forget_stencils, holds_weights, forget_weights
-   use node_based_kernels, only: store_shape_values
+   use stencil_cache, only: stencil_cache_t, forget_stencils
    use test_scenes, only: water_scene, add_body
    implicit none
    private
 
    public :: test_cached_transfers_bitwise_linear, test_cached_transfers_bitwise_bspline2, &
-             test_cached_transfers_bitwise_apic, test_unmatched_cache_not_read, test_kept_weights_are_nb_shape_values
+             test_cached_transfers_bitwise_apic, test_unmatched_cache_not_read
 
 contains
 
@@ -174,59 +172,4 @@ contains
       call assertEqual(-1, cache%count, 'forgotten: it holds no stencils')
       call solver%free()
    end subroutine test_unmatched_cache_not_read
-   !> P2G asked to keep the shape values (keep_weights, for NB): in 2-D on a multilinear grid with FLIP/PIC
-   !> it keeps each particle's base node and N_a(x_p) bit for bit as NB's own evaluation
-   !> (store_shape_values) gives them; in 3-D, with quadratic B-splines and with APIC it keeps none (NB
-   !> then evaluates them itself). Forgotten, they are not held.
-   subroutine test_kept_weights_are_nb_shape_values(comm)
-      type(MPI_Comm), intent(in) :: comm
-      character(len=8), parameter :: shapes(3) = [character(len=8) :: 'linear', 'bspline2', 'linear']
-      character(len=4), parameter :: transfers(3) = [character(len=4) :: 'flip', 'flip', 'apic']
-      integer :: dim, i
-      do dim = 2, 3
-         do i = 1, size(shapes)
-            call check_kept(dim, i)
-         end do
-      end do
-   contains
-      subroutine check_kept(dim, i)
-         integer, intent(in) :: dim, i
-         type(solver_t) :: solver      ! a new one for each case
-         type(stencil_cache_t) :: cache
-         type(scene_t) :: scene
-         type(status_t) :: status
-         integer, allocatable :: base(:)
-         real(rp), allocatable :: weight(:, :)
-         integer :: n, p, k
-         character(len=:), allocatable :: what
-         what = ' ('//achar(iachar('0') + dim)//'-D, '//trim(shapes(i))//', '//trim(transfers(i))//')'
-         scene = water_scene(dim, 0.1_rp, [1.0_rp, 0.8_rp, 0.6_rp], 2.0e6_rp, 9.81_rp)
-         call add_body(scene, 1, [0.13_rp, 0.05_rp, 0.1_rp], [0.83_rp, 0.55_rp, 0.4_rp], 2, .false., 0.0_rp)
-         scene%grid%shape_function = shapes(i)
-         scene%run%transfer = transfers(i)
-         call solver%init(scene, comm, status)
-         call assertTrue(status%ok, 'solver init: '//trim(status%message))
-         n = solver%particles%count
-         do p = 1, n     ! off the lattice: every weight non-trivial
-            solver%particles%x(:, p) = solver%particles%x(:, p) + &
-                                       0.01_rp * [(sin(2.1_rp * solver%particles%id(p) + k), k = 1, dim)]
-         end do
-         cache%keep_weights = .true.
-         call particles_to_grid(solver%grid, solver%particles, solver%gravity, stencils=cache)
-         if (i == 1 .and. dim == 2) then
-            call assertTrue(holds_weights(cache, n), 'kept'//what)
-            allocate (base(n), weight(solver%grid%stencil_size, n))
-            call store_shape_values(solver%grid, solver%particles, 1, n, base, weight)
-            call assertTrue(all(cache%base(1:n) == base), 'the base nodes NB finds'//what)
-            call assertTrue(all(cache%weight(:, 1:n) == weight), 'the shape values NB evaluates, bit for bit'//what)
-            call assertTrue(any(weight /= 0.0_rp .and. weight /= 1.0_rp), 'weights off the nodes'//what)
-            deallocate (base, weight)
-            call forget_weights(cache)
-            call assertTrue(.not. holds_weights(cache, n), 'forgotten'//what)
-         else
-            call assertTrue(.not. holds_weights(cache, n), 'not kept'//what)
-         end if
-         call solver%free()
-      end subroutine check_kept
-   end subroutine test_kept_weights_are_nb_shape_values
 end module test_stencil_cache
