@@ -329,25 +329,26 @@ contains
    subroutine solver_balance_load(self, status)
       class(solver_t), intent(inout) :: self
       type(status_t), intent(inout) :: status
-      integer(i8) :: counts(self%domain%nranks), largest
+      integer(i8) :: counts(self%domain%nranks), largest, now_largest
       integer :: cuts(0:self%domain%nranks, 3)
       real(rp) :: total, allowed
       if (self%domain%nranks == 1 .or. self%run%rebalance_threshold <= 0.0_rp) return
       call MPI_Allgather(int(self%particles%count, i8), 1, MPI_INTEGER8, counts, 1, MPI_INTEGER8, self%domain%comm)
       call count_collective(comm_balance, self%domain%nranks, int8_bytes)
-      ! in units of the mean count: the largest count, and what the threshold allows
+      ! compared as counts times the number of ranks: the largest count against threshold x total
+      now_largest = maxval(counts)
       total = real(sum(counts), rp)
       allowed = self%run%rebalance_threshold * total
-      if (real(maxval(counts), rp) * self%domain%nranks <= allowed) return
+      if (real(now_largest, rp) * self%domain%nranks <= allowed) return
       if (self%unimproved_largest > 0) then
-         if (real(maxval(counts) - self%unimproved_largest, rp) * self%domain%nranks <= allowed - total) return
+         if (real(now_largest - self%unimproved_largest, rp) * self%domain%nranks <= allowed - total) return
       end if
       self%layout_searches = self%layout_searches + 1
       call balanced_layout(self%domain, self%grid, self%particles, cuts, largest)
-      if (largest < maxval(counts)) then
+      if (largest < now_largest) then
          call self%set_layout(cuts, status)
       else
-         self%unimproved_largest = maxval(counts)     ! no better layout: keep this one
+         self%unimproved_largest = now_largest     ! no better layout: keep this one
       end if
    end subroutine solver_balance_load
 
