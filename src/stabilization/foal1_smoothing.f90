@@ -103,12 +103,7 @@ contains
          end if
          self%n_packed = self%occupied%count
          self%packed(1:self%n_packed) = self%occupied%cells(1:self%n_packed)
-         call exchange_cell_halo(context%domain, context%grid, self%box, field)
-         associate (ghost => self%box%ghost)
-            do i = 1, size(ghost)
-               exists(ghost(i)) = field(1, ghost(i)) > 0.5_rp
-            end do
-         end associate
+         call exchange_cell_halo(context%domain, context%grid, self%box, field, flags=exists)
 
          ! (d) limited face fluxes
          call field_flux_increments(self%box, context%grid%h, exists, field, self%options, dq, self%workspace)

@@ -197,6 +197,7 @@ contains
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(in) :: particles
       logical, intent(in) :: reliable(:)
+      real(rp), parameter :: clearly_shorter = 0.999_rp     ! squared length ratio: far above round-off
       real(rp) :: length, scale, longest
       integer :: m, p
       if (allocated(self%shift)) then
@@ -212,6 +213,11 @@ contains
          scale = -self%shifting_coefficient(m) * self%interval * grid%h**2
          do p = particles%material_first(m), particles%material_last(m)
             self%shift(:, p) = scale * self%shift(:, p)
+         end do
+         ! the cap: norm2 (scaled, a division per component) only where the plain sum of squares does not
+         ! show the shift clearly shorter (most particles move far less than the cap)
+         do p = particles%material_first(m), particles%material_last(m)
+            if (sum(self%shift(:, p)**2) < clearly_shorter * longest**2) cycle
             length = norm2(self%shift(:, p))
             if (length > longest) self%shift(:, p) = self%shift(:, p) * (longest / length)
          end do
@@ -419,13 +425,14 @@ contains
       type(wall_t), intent(in) :: walls(:)
       integer :: dim, i, j, l, k, g(3), node, s(3), per_axis, first(2), last(2), nb(2)
       real(rp) :: x_node(3), x(3), weight, sub, reach(2), rise, lowest, volume, extent(3), u, surface, share, &
-                  rise_of_part, half_depth
+                  rise_of_part, half_depth, sub_volume
       logical, allocatable :: counts(:)
 
       dim = grid%dim
       counts = walls%active .and. walls%kind /= wall_kind_prescribed
       per_axis = 2 * surface_samples_per_cell(dim)
       sub = grid%h / surface_samples_per_cell(dim)
+      sub_volume = sub**dim
       nb = shape(self%surface_height)
       rise = grid%h * sum(abs(self%up(1:dim)))                ! the support's top above its node
       extent = sub * abs(self%up)                              ! a sub-cell's depth along up, per axis
@@ -461,7 +468,7 @@ contains
                volume = 0.0_rp
                s = 1
                do
-                  weight = sub**dim
+                  weight = sub_volume
                   do k = 1, dim
                      x(k) = x_node(k) + grid%h * (-1.0_rp + (real(s(k), rp) - 0.5_rp) / surface_samples_per_cell(dim))
                      weight = weight * (1.0_rp - abs(x(k) - x_node(k)) * grid%inv_h)
@@ -472,7 +479,7 @@ contains
                      if (surface < half_depth) call part_below(surface, extent(1:dim), share, rise_of_part)
                      if (share < 1.0_rp) then
                         ! N_i at the part's height (exact for a cut along a grid axis; N is linear there)
-                        weight = sub**dim
+                        weight = sub_volume
                         do k = 1, dim
                            weight = weight * (1.0_rp - abs(x(k) + rise_of_part * self%up(k) - x_node(k)) * grid%inv_h)
                         end do
