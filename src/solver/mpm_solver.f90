@@ -19,7 +19,7 @@ module mpm_solver
    use communication_counters, only: count_collective, comm_time_step, comm_balance, comm_other, real_bytes, int8_bytes
    use scene_description, only: scene_t, run_control_t, wall_spec_t, model_newtonian_fluid
    use domain_decomposition, only: domain_t, layout_dims, fit_box, min_slab_width
-   use shape_functions, only: shape_function_kind, ghost_node_layers
+   use shape_functions, only: shape_function_kind, ghost_node_layers, shape_linear
    use load_balance, only: balanced_layout
    use particle_redistribution, only: redistribute_particles
    use background_grid, only: grid_t, row_mass
@@ -35,6 +35,7 @@ module mpm_solver
    use newtonian_fluid, only: newtonian_fluid_t
    use stabilizer, only: stabilizer_slot_t, stage_context_t
    use stabilizer_factory, only: build_stabilizers
+   use c0_anti_locking, only: c0_anti_locking_t
    use volume_correction, only: volume_corrector_t, max_shift_in_cells
    use boundary_walls, only: wall_t, build_walls, build_structures, set_wall_activity, apply_wall_constraints, &
                              keep_particles_inside, first_particle_inside, box_side_walls, wall_distance, move_walls, &
@@ -92,6 +93,9 @@ module mpm_solver
       real(rp) :: mass_tolerance = 0.0_rp       !< nodes lighter than this carry no velocity
       logical :: musl = .false.
       real(rp), allocatable :: remapped_momentum(:, :)
+      !> per material: its scheme forms the filtered rate of deformation from the nodal velocities, and G2P
+      !> forms no particle rates (see rates_from_grid)
+      logical, allocatable :: rate_from_grid(:)
       type(stencil_cache_t) :: stencils        !< the particles' stencils from P2G to G2P of a step (3-D)
       real(rp) :: extent(3, 2) = 0.0_rp         !< lowest and highest particle position after the last move
       integer :: relayouts = 0                  !< layouts made because the particles outgrew the active region
@@ -167,14 +171,17 @@ contains
       call self%gauges%init(scene, frame, self%gravity)
       call self%bodies%init(scene, self%materials, frame, self%gravity)
       call self%contact%init(scene, self%bodies, size(self%materials))
+      self%rate_from_grid = rates_from_grid(self)
 
       ! the rate of deformation and the spin are held per particle only for a material with a scheme, which
       ! filters the rate between G2P and the stress update (the spin only if such a model reads it: the
-      ! solids' Jaumann rate); the others' stay in move_particles' block buffer
+      ! solids' Jaumann rate), and the rate only if the scheme does not take it from the grid; the others'
+      ! stay in move_particles' block buffer
       filtered = [(allocated(self%schemes(i)%scheme), i = 1, size(self%materials))]
       call self%particles%init(scene%grid%dim, size(scene%materials), 1024, affine=scene%run%transfer == 'apic', &
                                spin=any([(self%materials(i)%model%uses_spin .and. filtered(i), &
-                                          i = 1, size(self%materials))]), strain_rate=any(filtered))
+                                          i = 1, size(self%materials))]), &
+                               strain_rate=any(filtered .and. .not. self%rate_from_grid))
       seed = .true.
       if (present(seed_particles)) seed = seed_particles
       if (seed) call seed_bodies(scene, self%grid, self%domain, self%particles)
@@ -454,6 +461,12 @@ contains
       context%grid => self%grid
       context%stencils => self%stencils
       context%dt = dt
+      ! the rate's nodal velocities (rows 1:dim: with contact fields the common field's)
+      if (self%musl .and. self%contact%active) then
+         context%strain_velocity => self%contact%remapped
+      else if (self%musl) then
+         context%strain_velocity => self%remapped_momentum
+      end if
       ! a scheme of a material no body or opened inlet supplies has no particles on any rank: skip it (its
       ! halo exchange and cell scans); a supplied one runs on every rank, with or without particles there
       do m = 1, size(self%schemes)
@@ -504,9 +517,14 @@ contains
          first = self%particles%material_first(m)
          last = self%particles%material_last(m)
          if (last < first .or. .not. allocated(self%schemes(m)%scheme)) cycle
-         call self%materials(m)%model%update_stress(self%grid%dim, dt, self%particles%strain_rate(:, first:last), &
-                                                   self%particles%spin(:, first:last), &
-                                                   self%particles%density(first:last), self%particles%sbar(:, first:last))
+         if (self%rate_from_grid(m)) then
+            call update_stress_from_cell_rates(self, m, dt)
+         else
+            call self%materials(m)%model%update_stress(self%grid%dim, dt, self%particles%strain_rate(:, first:last), &
+                                                      self%particles%spin(:, first:last), &
+                                                      self%particles%density(first:last), &
+                                                      self%particles%sbar(:, first:last))
+         end if
       end do
       call self%timers%switch_to(phase_stabilization)
       do m = 1, size(self%schemes)
@@ -565,8 +583,53 @@ contains
          integer, intent(in) :: material
          context%first = self%particles%material_first(material)
          context%last = self%particles%material_last(material)
+         context%rate_from_grid = self%rate_from_grid(material)
       end subroutine set_slice
    end subroutine solver_advance
+
+   !> The stress update of material m, whose scheme keeps the filtered rates per cell (rate_from_grid): block
+   !> by block, each block's rates gathered into a buffer that stays in L1 (as move_particles does for the
+   !> unfiltered materials), so that no particle array is written and read again.
+   subroutine update_stress_from_cell_rates(self, m, dt)
+      type(solver_t), intent(inout) :: self
+      integer, intent(in) :: m
+      real(rp), intent(in) :: dt
+      integer, parameter :: block_size = 256
+      real(rp) :: rate(self%particles%n_sigma, block_size)
+      integer :: b, e
+      select type (scheme => self%schemes(m)%scheme)
+      class is (c0_anti_locking_t)
+         do b = self%particles%material_first(m), self%particles%material_last(m), block_size
+            e = min(self%particles%material_last(m), b + block_size - 1)
+            call scheme%rates_of_particles(self%particles, b, e, rate)
+            call self%materials(m)%model%update_stress(self%grid%dim, dt, rate(:, 1:e - b + 1), &
+                                                      self%particles%spin(:, b:e), self%particles%density(b:e), &
+                                                      self%particles%sbar(:, b:e))
+         end do
+      end select
+   end subroutine update_stress_from_cell_rates
+
+   !> Per material: whether its scheme takes the filtered rate of deformation from the grid (C0 and FOAL1 with
+   !> full tensors: cell_strain_rate). It needs all the material's particles to read their rate's nodal
+   !> velocities from one field (MUSL's re-mapped ones; with contact fields the common field, which holds
+   !> every particle of a material in no &contact), multilinear shape functions (the cell's particles share
+   !> the cell's nodes), and a model that reads no spin (the only other use of the particle's velocity
+   !> gradient).
+   function rates_from_grid(self) result(from_grid)
+      type(solver_t), intent(in) :: self
+      logical :: from_grid(size(self%materials))
+      integer :: m
+      from_grid = .false.
+      do m = 1, size(self%materials)
+         if (.not. allocated(self%schemes(m)%scheme)) cycle
+         select type (scheme => self%schemes(m)%scheme)
+         class is (c0_anti_locking_t)    ! and FOAL1, which extends it
+            from_grid(m) = scheme%takes_rate_from_grid() .and. self%musl .and. self%grid%shape == shape_linear .and. &
+                           .not. self%materials(m)%model%uses_spin
+            if (self%contact%active) from_grid(m) = from_grid(m) .and. .not. self%contact%contact_material(m)
+         end select
+      end do
+   end function rates_from_grid
 
    !> True if material m may have particles on some rank now: a body of it, or an inlet of it that has
    !> opened. The same on every rank (scene and time only), so collective stages can be skipped by it.
@@ -740,7 +803,7 @@ contains
       real(rp) :: rate(self%particles%n_sigma, block_size), extent(3, 2)
       real(rp), allocatable :: spin(:, :)
       integer :: m, first, last, b, e, dim
-      logical :: uses_spin
+      logical :: uses_spin, with_rate
 
       dim = self%grid%dim
       self%extent(:, 1) = 0.0_rp
@@ -753,6 +816,7 @@ contains
          last = self%particles%material_last(m)
          if (last < first) cycle
          uses_spin = self%materials(m)%model%uses_spin
+         with_rate = .not. self%rate_from_grid(m)
          if (self%rigid%active) then
             if (self%rigid%rigid_material(m)) then
                ! rigid bodies move as wholes (rigid_bodies): no G2P, no stress
@@ -788,27 +852,27 @@ contains
          associate (run => self%run, contact => self%contact)
             if (contact%active .and. self%musl) then
                call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
-                                      update_velocity=.false., compute_strain=.true., update_position=.true., &
+                                      update_velocity=.false., compute_strain=with_rate, update_position=.true., &
                                       strain_velocity=contact%remapped, compute_spin=uses_spin, extent=extent, &
                                       field=contact%particle_field, velocity=contact%velocity, &
                                       increment=contact%increment, first=first, last=last, strain_rate=d, spin=w, &
                                       stencils=self%stencils)
             else if (contact%active) then
                call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
-                                      update_velocity=.true., compute_strain=.true., update_position=.true., &
+                                      update_velocity=.true., compute_strain=with_rate, update_position=.true., &
                                       compute_spin=uses_spin, extent=extent, field=contact%particle_field, &
                                       velocity=contact%velocity, increment=contact%increment, first=first, &
                                       last=last, strain_rate=d, spin=w, &
                                       stencils=self%stencils)
             else if (self%musl) then
                call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
-                                      update_velocity=.false., compute_strain=.true., update_position=.true., &
+                                      update_velocity=.false., compute_strain=with_rate, update_position=.true., &
                                       strain_velocity=self%remapped_momentum, compute_spin=uses_spin, &
                                       extent=extent, first=first, last=last, strain_rate=d, spin=w, &
                                       stencils=self%stencils)
             else
                call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
-                                      update_velocity=.true., compute_strain=.true., update_position=.true., &
+                                      update_velocity=.true., compute_strain=with_rate, update_position=.true., &
                                       compute_spin=uses_spin, extent=extent, first=first, last=last, &
                                       strain_rate=d, spin=w, &
                                       stencils=self%stencils)

@@ -15,6 +15,7 @@
 module cell_binning
    use kinds, only: rp
    use particle_set, only: particle_set_t
+   use background_grid, only: grid_t
    implicit none
    private
 
@@ -25,6 +26,7 @@ module cell_binning
    end type cell_list_t
 
    public :: start_cell_list, bin_cell_mass, bin_cell_mass_and_centre, cell_average, replace_by_cell_average
+   public :: bin_cell_mass_and_local_moments
    public :: divide_by_cell_mass, gather_cell_values
 
 contains
@@ -71,6 +73,33 @@ contains
          call divide_by_cell_mass(3, occupied, cell_mass, centre)
       end select
    end subroutine bin_cell_mass_and_centre
+
+   !> 3-D: m_c and the mass-weighted means over the cell's particles of their position xi in the cell (in
+   !> cells, 0..1 from its lower corner: G2P's xi at x^n) and of xi_2 xi_3, xi_1 xi_3, xi_1 xi_2, moments(1:6, c):
+   !> what the mean of the trilinear shape gradients over the particles needs (cell_strain_rate). With
+   !> `centre` also the mass centre x_o^c (the sums of bin_cell_mass_and_centre, in the same order: bit for
+   !> bit its result). One pass over the particles; `occupied` lists the cells afterwards; moments and centre
+   !> are written on the listed cells.
+   subroutine bin_cell_mass_and_local_moments(grid, particles, first, last, occupied, cell_mass, moments, centre)
+      type(grid_t), intent(in) :: grid
+      type(particle_set_t), intent(in) :: particles
+      integer, intent(in) :: first, last
+      type(cell_list_t), intent(inout) :: occupied
+      real(rp), intent(inout) :: cell_mass(:), moments(:, :)
+      real(rp), intent(inout), optional :: centre(:, :)
+      call clear_listed(occupied, cell_mass)
+      if (last < first) return
+      associate (cell => particles%cell(first:last), mass => particles%mass(first:last), x => particles%x(:, first:last))
+         if (present(centre)) then
+            call mass_and_local_moment_sums(grid, cell, mass, x, cell_mass, moments, occupied%cells, occupied%count, &
+                                            centre)
+            call divide_by_cell_mass(3, occupied, cell_mass, centre)
+         else
+            call mass_and_local_moment_sums(grid, cell, mass, x, cell_mass, moments, occupied%cells, occupied%count)
+         end if
+         call divide_by_cell_mass(6, occupied, cell_mass, moments)
+      end associate
+   end subroutine bin_cell_mass_and_local_moments
 
    !> cell_mass := 0 on the listed cells, and the list emptied (so cell_mass is 0 everywhere).
    subroutine clear_listed(occupied, cell_mass)
@@ -258,6 +287,56 @@ contains
       cell_mass(c) = running_mass
       moment(:, c) = running_moment
    end subroutine mass_and_moment_sums
+
+   !> The sums of bin_cell_mass_and_local_moments, and with `centre` of m_p x_p. A run's cell gives the lower
+   !> corner (grid%cell_indices: its global indices, the lower node G2P's LOCATE finds for the particles in it),
+   !> and xi = (x - origin) / h - lower as LOCATE computes it.
+   subroutine mass_and_local_moment_sums(grid, cell, mass, x, cell_mass, moment, list, count, centre)
+      type(grid_t), intent(in) :: grid
+      integer, intent(in) :: cell(:)
+      real(rp), intent(in) :: mass(:), x(3, *)
+      real(rp), intent(inout) :: cell_mass(:), moment(6, *)
+      integer, intent(inout) :: list(:), count
+      real(rp), intent(inout), optional :: centre(3, *)
+      integer :: i, c
+      real(rp) :: running_mass, running_moment(6), running_centre(3), xi(3), origin(3), lower(3), inv_h
+      origin = grid%origin
+      inv_h = grid%inv_h
+      c = 0
+      running_mass = 0.0_rp
+      running_moment = 0.0_rp
+      running_centre = 0.0_rp
+      lower = 0.0_rp
+      count = 0
+      do i = 1, size(cell)
+         if (cell(i) /= c) then
+            if (c > 0) then
+               cell_mass(c) = running_mass
+               moment(:, c) = running_moment
+               if (present(centre)) centre(:, c) = running_centre
+            end if
+            c = cell(i)
+            running_mass = cell_mass(c)
+            if (running_mass <= 0.0_rp) then      ! first visit: the sums are not cleared in memory
+               count = count + 1
+               list(count) = c
+               running_moment = 0.0_rp
+               running_centre = 0.0_rp
+            else
+               running_moment = moment(:, c)
+               if (present(centre)) running_centre = centre(:, c)
+            end if
+            lower = real(grid%cell_indices(c), rp)
+         end if
+         xi = (x(:, i) - origin) * inv_h - lower
+         running_mass = running_mass + mass(i)
+         running_moment = running_moment + mass(i) * [xi, xi(2) * xi(3), xi(1) * xi(3), xi(1) * xi(2)]
+         if (present(centre)) running_centre = running_centre + mass(i) * x(:, i)
+      end do
+      cell_mass(c) = running_mass
+      moment(:, c) = running_moment
+      if (present(centre)) centre(:, c) = running_centre
+   end subroutine mass_and_local_moment_sums
 
    subroutine gather(n, cell, cell_values, values)
       integer, intent(in) :: n, cell(:)

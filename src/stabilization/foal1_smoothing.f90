@@ -13,7 +13,8 @@ module foal1_smoothing
    use particle_set, only: particle_set_t
    use stabilizer, only: stage_context_t
    use c0_anti_locking, only: c0_anti_locking_t
-   use cell_binning, only: cell_list_t, bin_cell_mass_and_centre, cell_average, gather_cell_values
+   use cell_binning, only: cell_list_t, bin_cell_mass_and_centre, cell_average, gather_cell_values, &
+                           bin_cell_mass_and_local_moments
    use cell_halo, only: padded_cells_t, exchange_cell_halo, halo_width
    use background_grid, only: grid_t
    use limited_flux_smoothing, only: flux_options_t, flux_workspace_t, field_flux_increments
@@ -34,12 +35,14 @@ module foal1_smoothing
       type(flux_workspace_t) :: workspace
    contains
       procedure :: prepare => foal1_prepare
+      procedure :: filter_strain_rate => foal1_filter_strain_rate
       procedure :: filter_stress => foal1_filter_stress
    end type foal1_smoothing_t
 
 contains
 
-   !> C0's cell masses plus the mass centres, at x^n (one pass).
+   !> C0's cell masses plus the mass centres, at x^n (one pass); with the rate from the grid in 3-D also the
+   !> local moments (in 2-D the rate needs the mass centres only).
    subroutine foal1_prepare(self, context, particles)
       class(foal1_smoothing_t), intent(inout) :: self
       type(stage_context_t), intent(in) :: context
@@ -53,8 +56,27 @@ contains
          if (size(self%centre, 2) /= context%grid%cell_count) deallocate (self%centre)
       end if
       if (.not. allocated(self%centre)) allocate (self%centre(context%grid%dim, context%grid%cell_count))
-      call bin_cell_mass_and_centre(particles, context%first, context%last, self%occupied, self%cell_mass, self%centre)
+      if (context%rate_from_grid .and. context%grid%dim == 3) then
+         call self%size_means(context%grid)
+         call bin_cell_mass_and_local_moments(context%grid, particles, context%first, context%last, self%occupied, &
+                                              self%cell_mass, self%means, self%centre)
+      else
+         call bin_cell_mass_and_centre(particles, context%first, context%last, self%occupied, self%cell_mass, &
+                                       self%centre)
+      end if
    end subroutine foal1_prepare
+
+   !> C0's filter of the rate (step (a)); with the rate from the grid in 2-D from the mass centres FOAL1 keeps.
+   subroutine foal1_filter_strain_rate(self, context, particles)
+      class(foal1_smoothing_t), intent(inout) :: self
+      type(stage_context_t), intent(in) :: context
+      type(particle_set_t), intent(inout) :: particles
+      if (context%rate_from_grid .and. context%grid%dim == 2) then
+         call self%rates_from_grid(context, self%centre)
+      else
+         call self%c0_anti_locking_t%filter_strain_rate(context, particles)
+      end if
+   end subroutine foal1_filter_strain_rate
 
    !> Steps (c) to (e) for the material's particles.
    subroutine foal1_filter_stress(self, context, particles)

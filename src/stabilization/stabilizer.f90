@@ -25,6 +25,12 @@ module stabilizer
       !> is its nodal mass (NB uses it)
       logical :: sole_material = .false.
       type(stencil_cache_t), pointer :: stencils => null()   !< P2G's stencils of this step (3-D; valid until G2P)
+      !> the scheme takes the material's rate of deformation from strain_velocity(1:dim, node), the nodal
+      !> velocities G2P would form it from, and G2P leaves the particles' rates out (the solver sets it where
+      !> a C0 or FOAL1 scheme takes_rate_from_grid and the step allows it: c0_anti_locking). More rows than dim
+      !> are other velocity fields (contact), not read.
+      logical :: rate_from_grid = .false.
+      real(rp), pointer, contiguous :: strain_velocity(:, :) => null()
    end type stage_context_t
 
    type, abstract, public :: stabilizer_t

@@ -3,6 +3,8 @@
 !>    rank and on all ranks of `comm` (<= 1e-13 relative): the cell halo carries what the fluxes need;
 !>  - FOAL1 with gamma_max = 0 is C0, bit for bit;
 !>  - C0 in 2-D is one-point quadrature at the cell mass centre (algorithms.md section 2.2);
+!>  - C0's and FOAL1's rate from the grid (cell_strain_rate) is the cell average of the particles' rates, in
+!>    2-D and 3-D (<= 1e-12 relative), with particles off the lattice;
 !>  - NB of the only material takes the grid's mass row of P2G for its own nodal masses, bit for bit;
 !>  - FOAL1 and NB of two materials keep each material's sum m_p s_p.
 module test_stabilization_consistency
@@ -15,6 +17,7 @@ module test_stabilization_consistency
    use mpm_solver, only: solver_t
    use run_diagnostics, only: diagnostics_t
    use stabilizer, only: stage_context_t
+   use c0_anti_locking, only: c0_anti_locking_t
    use grid_transfer, only: grid_to_particles, particles_to_grid
    use node_halo, only: sum_shared_nodes
    use shape_functions, only: n_corners, corner_offset, shape_values_and_gradients
@@ -25,7 +28,9 @@ module test_stabilization_consistency
    public :: test_c0_volumetric_only, &
              test_conservation_per_material, test_random_field_rank_invariance, test_checkerboard_rank_invariance, &
              test_random_field_3d_rank_invariance, &
-             test_gamma_zero_is_c0, test_c0_is_one_point_quadrature_2d, test_nb_sole_material_grid_mass
+             test_gamma_zero_is_c0, test_c0_is_one_point_quadrature_2d, test_nb_sole_material_grid_mass, &
+             test_c0_rate_from_grid_2d, test_c0_rate_from_grid_3d, test_foal1_rate_from_grid_2d, &
+             test_foal1_rate_from_grid_3d
 
    integer, parameter :: random_field = 1, checkerboard = 2
 
@@ -370,6 +375,7 @@ contains
       real(rp) :: xi(2), n(4), g(2, 4), l(2, 2), d_expected(4), c_real(3)
       integer :: i, p, c, a, k, cell(3), base, checked
       scene = block_scene(2, 'C0')
+      scene%run%update_scheme = 'USL'    ! the solver keeps particle rates (with MUSL C0 takes them from the grid)
       ! particles away from the lattice of cell centres, so that mass centres are not cell centres
       scene%bodies(1)%lower(1) = 0.33_rp
       scene%bodies(1)%upper(1) = 2.33_rp
@@ -419,4 +425,87 @@ contains
       call assertTrue(checked > 0 .and. corner_offset(4, 2) == 1, 'particles checked')
       call solver%free()
    end subroutine test_c0_is_one_point_quadrature_2d
+
+   subroutine test_c0_rate_from_grid_2d(comm)
+      type(MPI_Comm), intent(in) :: comm
+      call compare_rate_from_grid(comm, 2, 'C0')
+   end subroutine test_c0_rate_from_grid_2d
+
+   subroutine test_c0_rate_from_grid_3d(comm)
+      type(MPI_Comm), intent(in) :: comm
+      call compare_rate_from_grid(comm, 3, 'C0')
+   end subroutine test_c0_rate_from_grid_3d
+
+   subroutine test_foal1_rate_from_grid_2d(comm)
+      type(MPI_Comm), intent(in) :: comm
+      call compare_rate_from_grid(comm, 2, 'FOAL1')
+   end subroutine test_foal1_rate_from_grid_2d
+
+   subroutine test_foal1_rate_from_grid_3d(comm)
+      type(MPI_Comm), intent(in) :: comm
+      call compare_rate_from_grid(comm, 3, 'FOAL1')
+   end subroutine test_foal1_rate_from_grid_3d
+
+   !> C0's d~_c from the grid (context%rate_from_grid: cell_strain_rate, from the cells' local moments) against
+   !> the mass-weighted cell average of the particles' own rates from G2P, with the same arbitrary nodal
+   !> velocities. The particles are moved off their lattice (within their cells), so that the mean of a
+   !> product of two coordinates is not the product of their means: in 3-D the moments must carry it.
+   subroutine compare_rate_from_grid(comm, dim, scheme_name)
+      type(MPI_Comm), intent(in) :: comm
+      integer, intent(in) :: dim
+      character(len=*), intent(in) :: scheme_name
+      type(solver_t), target :: solver
+      type(scene_t) :: scene
+      type(status_t) :: status
+      type(stage_context_t) :: context
+      real(rp), allocatable, target :: velocity(:, :)
+      real(rp), allocatable :: expected(:, :), from_grid(:, :)
+      real(rp) :: scale
+      integer :: i, k, p, first, last
+      scene = block_scene(dim, scheme_name)
+      scene%run%update_scheme = 'USL'    ! the solver keeps particle rates (the test chooses the path itself)
+      call solver%init(scene, comm, status)
+      call assertTrue(status%ok, 'solver init: '//trim(status%message))
+      do p = 1, solver%particles%count
+         do k = 1, dim
+            solver%particles%x(k, p) = solver%particles%x(k, p) + 0.2_rp * scene%grid%cell_size * sin(3.1_rp * p + 1.7_rp * k)
+         end do
+      end do
+      allocate (velocity(dim, solver%grid%node_count))
+      do i = 1, solver%grid%node_count
+         do k = 1, dim
+            velocity(k, i) = sin(1.7_rp * i + 0.9_rp * k) + cos(0.3_rp * i**2 * k)
+         end do
+      end do
+      first = solver%particles%material_first(1)
+      last = solver%particles%material_last(1)
+      context%domain => solver%domain
+      context%grid => solver%grid
+      context%first = first
+      context%last = last
+      context%strain_velocity => velocity
+      ! the particles' own rates, averaged per cell
+      context%rate_from_grid = .false.
+      call solver%schemes(1)%scheme%prepare(context, solver%particles)
+      call grid_to_particles(solver%grid, solver%particles, 1.0e-3_rp, 1.0_rp, 1.0_rp, .false., .true., .false., &
+                             solver%particles%strain_rate, solver%particles%spin, strain_velocity=velocity)
+      call solver%schemes(1)%scheme%filter_strain_rate(context, solver%particles)
+      expected = solver%particles%strain_rate(:, first:last)
+      ! the rates from the grid, as the solver's stress update takes them
+      context%rate_from_grid = .true.
+      call solver%schemes(1)%scheme%prepare(context, solver%particles)
+      call solver%schemes(1)%scheme%filter_strain_rate(context, solver%particles)
+      allocate (from_grid, mold=expected)
+      from_grid = 0.0_rp
+      select type (scheme => solver%schemes(1)%scheme)
+      class is (c0_anti_locking_t)
+         call assertTrue(scheme%takes_rate_from_grid(), scheme_name//' with full tensors takes its rate from the grid')
+         call scheme%rates_of_particles(solver%particles, first, last, from_grid)
+      end select
+      scale = maxval(abs(expected))
+      call assertTrue(last >= first .and. scale > 0.0_rp, 'particles with a rate')
+      call assertEqual(0.0_rp, maxval(abs(from_grid - expected)) / scale, 1.0e-12_rp, &
+                       scheme_name//': d~_c from the grid = the cell average of the particle rates')
+      call solver%free()
+   end subroutine compare_rate_from_grid
 end module test_stabilization_consistency
