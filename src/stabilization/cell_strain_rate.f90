@@ -5,10 +5,9 @@
 !> of grad N_i is a product of the 1-D functions f_0(s) = 1 - s, f_1(s) = s of the other coordinates, so
 !> Gbar_i needs only the cell's mean position in the cell (2-D: from its mass centre x_o^c, the "2D identity")
 !> and, in 3-D, also the means of the products of two coordinates (cell_binning's local moments): exact, not
-!> an approximation. Per cell instead of per
-!> particle, and G2P need not form the particles' velocity gradients at all: a C0 step without its most
-!> expensive per-particle work (docs/performance.md, "C0's rate from the grid"). The sums differ from
-!> the particle average's in round-off only.
+!> an approximation. Per cell instead of per particle, and G2P need not form the particles' velocity
+!> gradients at all: a C0 step without its most expensive per-particle work (docs/performance.md, "C0's
+!> rate from the grid"). The sums differ from the particle average's in round-off only.
 module cell_strain_rate
    use kinds, only: rp
    use background_grid, only: grid_t
@@ -39,8 +38,10 @@ contains
 
    !> 2-D: Gbar_a = grad N_a at the mean position (xi, eta) = (x_o^c - origin) / h - lower corner, so
    !> L(:, 1) = ((v_2 - v_1)(1 - eta) + (v_4 - v_3) eta) / h and L(:, 2) = ((v_3 - v_1)(1 - xi) + (v_4 - v_2) xi) / h
-   !> (corner a = 1 + o_1 + 2 o_2, the order of grid%stencil_stride). Arrays of literal leading sizes and the
-   !> grid's numbers in locals: the loop is scalar, and its indexing was half its instructions.
+   !> (corner a = 1 + o_1 + 2 o_2, the order of grid%stencil_stride). Arrays of literal leading sizes, and
+   !> grid%cell_indices and grid%base_node_of_cell written out with the grid's numbers in locals: the loop is
+   !> scalar and shared by only 4 particles a cell; calling the two (as rates_3d does) made the 2-D column's C0
+   !> 3-4 % slower (scripts/bench_compare, best of 5 rounds).
    subroutine rates_2d(grid, occupied, cell_mass, centre, rows, velocity, rates)
       type(grid_t), intent(in) :: grid
       type(cell_list_t), intent(in) :: occupied
@@ -59,7 +60,7 @@ contains
       do i = 1, occupied%count
          c = occupied%cells(i)
          if (cell_mass(c) <= 0.0_rp) cycle
-         ! local indices of the cell (grid%cell_indices, inlined)
+         ! local indices of the cell, as grid%cell_indices finds them
          g(2) = int((real(c - 1, rp) + 0.5_rp) * inv_row)
          g(1) = c - 1 - g(2) * row_cells
          xi = (centre(:, c) - origin) * inv_h - real(g + grid%cell_lo(1:2), rp)
@@ -84,14 +85,12 @@ contains
       ! the two axes other than k, and the row of moments holding the mean of their product
       integer, parameter :: other(2, 3) = reshape([2, 3, 1, 3, 1, 2], [2, 3]), product_row(3) = [4, 5, 6]
       real(rp) :: df(0:1), pair(0:1, 0:1, 3), gbar(3, 8), l(3, 3), v(3), s, t, st
-      integer :: i, c, a, k, node, base, o(3), g(3)
+      integer :: i, c, a, k, node, base, o(3)
       df = [-grid%inv_h, grid%inv_h]
       do i = 1, occupied%count
          c = occupied%cells(i)
          if (cell_mass(c) <= 0.0_rp) cycle
-         g = grid%cell_indices(c)
-         base = 1 + (g(1) - grid%node_lo(1)) + &
-                ((g(2) - grid%node_lo(2)) + (g(3) - grid%node_lo(3)) * grid%n_nodes(2)) * grid%n_nodes(1)
+         base = grid%base_node_of_cell(grid%cell_indices(c))
          ! pair(o_l, o_m, k): the mean of f(o_l, xi_l) f(o_m, xi_m) over the cell's particles
          do k = 1, 3
             s = moments(other(1, k), c)
