@@ -94,7 +94,7 @@ module mpm_solver
       logical :: musl = .false.
       real(rp), allocatable :: remapped_momentum(:, :)
       !> per material: its scheme forms the filtered rate of deformation from the nodal velocities, and G2P
-      !> forms no particle rates (see rates_from_grid)
+      !> forms no particle rates (see materials_taking_rate_from_grid)
       logical, allocatable :: rate_from_grid(:)
       type(stencil_cache_t) :: stencils        !< the particles' stencils from P2G to G2P of a step (3-D)
       real(rp) :: extent(3, 2) = 0.0_rp         !< lowest and highest particle position after the last move
@@ -171,7 +171,7 @@ contains
       call self%gauges%init(scene, frame, self%gravity)
       call self%bodies%init(scene, self%materials, frame, self%gravity)
       call self%contact%init(scene, self%bodies, size(self%materials))
-      self%rate_from_grid = rates_from_grid(self)
+      self%rate_from_grid = materials_taking_rate_from_grid(self)
 
       ! the rate of deformation and the spin are held per particle only for a material with a scheme, which
       ! filters the rate between G2P and the stress update (the spin only if such a model reads it: the
@@ -615,7 +615,7 @@ contains
    !> every particle of a material in no &contact), multilinear shape functions (the cell's particles share
    !> the cell's nodes), and a model that reads no spin (the only other use of the particle's velocity
    !> gradient).
-   function rates_from_grid(self) result(from_grid)
+   function materials_taking_rate_from_grid(self) result(from_grid)
       type(solver_t), intent(in) :: self
       logical :: from_grid(size(self%materials))
       integer :: m
@@ -629,7 +629,7 @@ contains
             if (self%contact%active) from_grid(m) = from_grid(m) .and. .not. self%contact%contact_material(m)
          end select
       end do
-   end function rates_from_grid
+   end function materials_taking_rate_from_grid
 
    !> True if material m may have particles on some rank now: a body of it, or an inlet of it that has
    !> opened. The same on every rank (scene and time only), so collective stages can be skipped by it.

@@ -8,7 +8,7 @@
 !> strain) and the mean specific stress are averaged; the particle keeps its deviatoric parts.
 !> The spin is never filtered [R].
 !> Full tensors and context%rate_from_grid (set by the solver where it holds: multilinear shape functions,
-!> MUSL, no contact fields, a model without spin): d~_c comes from the nodal velocities per cell
+!> MUSL, a material in no &contact, a model without spin): d~_c comes from the nodal velocities per cell
 !> (cell_strain_rate), G2P forms no rates of deformation, and `prepare` bins the cells' local moments.
 module c0_anti_locking
    use kinds, only: rp
