@@ -26,7 +26,7 @@ module cell_binning
    end type cell_list_t
 
    public :: start_cell_list, bin_cell_mass, bin_cell_mass_and_centre, cell_average, replace_by_cell_average
-   public :: bin_cell_mass_and_local_moments
+   public :: bin_cell_mass_and_local_moments, bin_cell_mass_and_mean
    public :: divide_by_cell_mass, gather_cell_values
 
 contains
@@ -73,6 +73,23 @@ contains
          call divide_by_cell_mass(3, occupied, cell_mass, centre)
       end select
    end subroutine bin_cell_mass_and_centre
+
+   !> m_c and the mass-weighted mean mean(1, c) = sum m_p values(p - first + 1) / m_c (where m_c > 0) of one
+   !> value per particle, for the particles first..last, in one pass: the sums of bin_cell_mass and of
+   !> cell_average, in the same order (bit for bit theirs). `occupied` lists the cells afterwards; `mean` is
+   !> written on the listed cells only.
+   subroutine bin_cell_mass_and_mean(particles, first, last, values, occupied, cell_mass, mean)
+      type(particle_set_t), intent(in) :: particles
+      integer, intent(in) :: first, last
+      real(rp), intent(in), contiguous :: values(:)
+      type(cell_list_t), intent(inout) :: occupied
+      real(rp), intent(inout) :: cell_mass(:), mean(:, :)
+      call clear_listed(occupied, cell_mass)
+      if (last < first) return
+      call mass_and_moment_sums(1, particles%cell(first:last), particles%mass(first:last), values, cell_mass, mean, &
+                                occupied%cells, occupied%count)
+      call divide_by_cell_mass(1, occupied, cell_mass, mean)
+   end subroutine bin_cell_mass_and_mean
 
    !> 3-D: m_c and the mass-weighted means over the cell's particles of their position xi in the cell (in
    !> cells, 0..1 from its lower corner: G2P's xi at x^n) and of xi_2 xi_3, xi_1 xi_3, xi_1 xi_2, moments(1:6, c):

@@ -42,7 +42,7 @@ module volume_correction
    use node_halo, only: sum_shared_nodes
    use particle_set, only: particle_set_t
    use boundary_walls, only: wall_t, wall_kind_prescribed, behind_wall
-   use cell_binning, only: cell_list_t, start_cell_list, bin_cell_mass, replace_by_cell_average
+   use cell_binning, only: cell_list_t, start_cell_list, bin_cell_mass_and_mean
    use newtonian_fluid, only: eos_pressure
    implicit none
    private
@@ -98,6 +98,9 @@ module volume_correction
       logical, allocatable :: wall_activity(:)      !< walls' activity V_i was measured with
       real(rp), allocatable :: excess(:, :)         !< (1, node): occupancy, then psi_i
       real(rp), allocatable :: shift(:, :)          !< (dim, p): displacement added after the position update
+      !> the surface cut looks the height up once per column of sub-cells where up is a grid axis (off: once per
+      !> sub-cell, the general way; the same volumes bit for bit, which a test checks)
+      logical :: lookup_per_column = .true.
    contains
       procedure :: init => corrector_init
       procedure :: reset_grid => corrector_reset_grid
@@ -211,12 +214,10 @@ contains
          call gradient_at_particles(grid, particles, particles%material_first(m), particles%material_last(m), &
                                     self%excess(1, :), reliable, self%shift)
          scale = -self%shifting_coefficient(m) * self%interval * grid%h**2
-         do p = particles%material_first(m), particles%material_last(m)
-            self%shift(:, p) = scale * self%shift(:, p)
-         end do
          ! the cap: norm2 (scaled, a division per component) only where the plain sum of squares does not
          ! show the shift clearly shorter (most particles move far less than the cap)
          do p = particles%material_first(m), particles%material_last(m)
+            self%shift(:, p) = scale * self%shift(:, p)
             if (sum(self%shift(:, p)**2) < clearly_shorter * longest**2) cycle
             length = norm2(self%shift(:, p))
             if (length > longest) self%shift(:, p) = self%shift(:, p) * (longest / length)
@@ -295,11 +296,13 @@ contains
    !> cell_binning, by particles%cell at x^n) applied to the specific volume 1/rho, whose mass-weighted
    !> mean is V_c / m_c. A particle's own J otherwise carries the history of the cells it crossed, and
    !> nothing in C0 or FOAL1 pulls it back (the pressure is the cell's), so it can drift without bound.
+   !> The masses and the specific volumes are summed in one pass (bin_cell_mass_and_mean), and the new
+   !> densities 1 / mean written in one more.
    subroutine equalize_cell_volumes(self, grid, particles)
       type(volume_corrector_t), intent(inout) :: self
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
-      integer :: m, first, last, n
+      integer :: m, first, last, n, p
       if (allocated(self%cell_mass)) then
          if (size(self%cell_mass) /= grid%cell_count) deallocate (self%cell_mass, self%cell_average)
       end if
@@ -312,18 +315,19 @@ contains
          first = particles%material_first(m)
          last = particles%material_last(m)
          if (last < first) cycle
-         call bin_cell_mass(particles, first, last, self%occupied, self%cell_mass)
          n = last - first + 1
          if (allocated(self%specific_volume)) then
             if (size(self%specific_volume, 2) < n) deallocate (self%specific_volume)
          end if
          if (.not. allocated(self%specific_volume)) allocate (self%specific_volume(1, size(particles%x, 2)))
-         associate (specific_volume => self%specific_volume(:, 1:n))
-            specific_volume(1, :) = 1.0_rp / particles%density(first:last)
-            call replace_by_cell_average(particles, first, last, self%occupied, self%cell_mass, specific_volume, &
-                                         self%cell_average)
-            particles%density(first:last) = 1.0_rp / specific_volume(1, :)
+         associate (specific_volume => self%specific_volume(1, 1:n))
+            specific_volume = 1.0_rp / particles%density(first:last)
+            call bin_cell_mass_and_mean(particles, first, last, specific_volume, self%occupied, self%cell_mass, &
+                                        self%cell_average)
          end associate
+         do p = first, last
+            particles%density(p) = 1.0_rp / self%cell_average(1, particles%cell(p))
+         end do
       end do
    end subroutine equalize_cell_volumes
 
@@ -419,14 +423,19 @@ contains
    !> fluid_volume(i) = int N_i over the open space below the height function, for the nodes whose support
    !> reaches above it somewhere (the others keep V_i): surface_samples_per_cell^dim sub-cells per cell, each
    !> counted with its exact fraction below the local surface plane.
+   !> Where up is the grid's last axis (gravity along it: the usual case), a column of sub-cells lies over
+   !> one bin, whose height is looked up once per column: x . horizontal and x . up are then x's own
+   !> coordinates, bit for bit, so the heights and surfaces are those of a lookup per sub-cell.
    subroutine cut_by_surface(self, grid, walls)
       type(volume_corrector_t), intent(inout) :: self
       type(grid_t), intent(in) :: grid
       type(wall_t), intent(in) :: walls(:)
-      integer :: dim, i, j, l, k, g(3), node, s(3), per_axis, first(2), last(2), nb(2)
+      integer, parameter :: max_columns = 16**2
+      integer :: dim, i, j, l, k, g(3), node, s(3), per_axis, first(2), last(2), nb(2), column
       real(rp) :: x_node(3), x(3), weight, sub, reach(2), rise, lowest, volume, extent(3), u, surface, share, &
-                  rise_of_part, half_depth, sub_volume
+                  rise_of_part, half_depth, sub_volume, column_height(max_columns)
       logical, allocatable :: counts(:)
+      logical :: upright
 
       dim = grid%dim
       counts = walls%active .and. walls%kind /= wall_kind_prescribed
@@ -440,6 +449,7 @@ contains
       do k = 1, dim - 1
          reach(k) = grid%h * sum(abs(self%horizontal(1:dim, k)))
       end do
+      upright = self%lookup_per_column .and. grid_axis_up(self, dim) .and. per_axis**(dim - 1) <= max_columns
       x_node = 0.0_rp
       x = 0.0_rp
       first = 1
@@ -465,6 +475,7 @@ contains
                   self%fluid_volume(node) = 0.0_rp
                   cycle
                end if
+               if (upright) call column_heights(x_node, column_height)
                volume = 0.0_rp
                s = 1
                do
@@ -473,7 +484,13 @@ contains
                      x(k) = x_node(k) + grid%h * (-1.0_rp + (real(s(k), rp) - 0.5_rp) / surface_samples_per_cell(dim))
                      weight = weight * (1.0_rp - abs(x(k) - x_node(k)) * grid%inv_h)
                   end do
-                  surface = surface_over(self, x, dim) - dot_product(x(1:dim), self%up(1:dim))
+                  if (upright) then
+                     column = s(1)
+                     if (dim == 3) column = column + per_axis * (s(2) - 1)
+                     surface = column_height(column) - x(dim)
+                  else
+                     surface = surface_over(self, x, dim) - dot_product(x(1:dim), self%up(1:dim))
+                  end if
                   if (surface > -half_depth) then     ! not wholly above the surface (no_surface is)
                      share = 1.0_rp
                      if (surface < half_depth) call part_below(surface, extent(1:dim), share, rise_of_part)
@@ -496,7 +513,44 @@ contains
             end do
          end do
       end do
+
+   contains
+
+      !> The height function over each column of sub-cells of the support of the node at x_node (columns
+      !> numbered as the samples' horizontal indices, the first fastest), as surface_over gives it at any
+      !> sample of the column.
+      subroutine column_heights(x_node, height)
+         real(rp), intent(in) :: x_node(3)
+         real(rp), intent(out) :: height(:)
+         real(rp) :: x_column(3)
+         integer :: c(2), column
+         x_column = x_node
+         c = 1
+         do column = 1, per_axis**(dim - 1)
+            c(1) = 1 + mod(column - 1, per_axis)
+            c(2) = 1 + (column - 1) / per_axis
+            do k = 1, dim - 1
+               x_column(k) = x_node(k) + grid%h * (-1.0_rp + (real(c(k), rp) - 0.5_rp) / surface_samples_per_cell(dim))
+            end do
+            height(column) = surface_over(self, x_column, dim)
+         end do
+      end subroutine column_heights
    end subroutine cut_by_surface
+
+   !> True if up is the grid's last axis and the horizontal directions its others, exactly (then a point's
+   !> height and horizontal coordinates are its own coordinates, bit for bit).
+   pure logical function grid_axis_up(self, dim) result(upright)
+      type(volume_corrector_t), intent(in) :: self
+      integer, intent(in) :: dim
+      integer :: k, l
+      ! exact comparisons, as inequalities of absolute differences
+      upright = abs(self%up(dim) - 1.0_rp) <= 0.0_rp .and. maxval(abs(self%up(1:dim - 1))) <= 0.0_rp
+      do k = 1, dim - 1
+         do l = 1, dim
+            upright = upright .and. abs(self%horizontal(l, k) - merge(1.0_rp, 0.0_rp, l == k)) <= 0.0_rp
+         end do
+      end do
+   end function grid_axis_up
 
    !> The height function over point x: its bin's height (no_surface where no particle is).
    pure real(rp) function surface_over(self, x, dim) result(height)

@@ -10,6 +10,8 @@
 !>    volumes, J and stress unchanged), rises back by more than half the drop, and stays pressed without
 !>    the correction; 2-D and 3-D;
 !>  - the sub-cell fraction under a surface plane is exact (box cut by a plane: known areas and volumes);
+!>  - the surface cut's height lookup once per column of sub-cells gives the lookup per sub-cell's shifts,
+!>    bit for bit, under a free surface that is not flat (2-D and 3-D);
 !>  - eos_relaxation starts a hydrostatic fluid in its EOS state p = K ln(rho/rho_0) and, at rate 1,
 !>    puts every particle's pressure back on it after each step.
 module test_volume_correction
@@ -30,7 +32,8 @@ module test_volume_correction
 
    public :: test_shifting_leaves_a_filled_tank_alone, test_shifting_spreads_crowded_particles, &
              test_eos_relaxation_keeps_the_eos_state, test_shift_takes_the_hydrostatic_pressure, &
-             test_shifting_lifts_a_crowded_surface_layer, test_fraction_below_a_plane
+             test_shifting_lifts_a_crowded_surface_layer, test_fraction_below_a_plane, &
+             test_column_lookup_is_the_sub_cell_lookup
 
 contains
 
@@ -115,6 +118,67 @@ contains
       call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [2.0_rp, 1.0_rp, 0.0_rp], 2, .false., 0.0_rp)
       call add_body(scene, 1, [0.5_rp, 0.2_rp, 0.0_rp], [1.5_rp, 0.8_rp, 0.0_rp], 2, .false., 0.0_rp)
    end function crowded_scene
+
+   !> A dam break (a water column beside a lower layer, so the surface has a step and then slopes) run a few
+   !> steps by two identical solvers; then the shifts of one application with the height looked up per
+   !> column of sub-cells and per sub-cell: the same, bit for bit, and not zero.
+   subroutine test_column_lookup_is_the_sub_cell_lookup(comm)
+      type(MPI_Comm), intent(in) :: comm
+      call compare_lookups(comm, 2)
+      call compare_lookups(comm, 3)
+   end subroutine test_column_lookup_is_the_sub_cell_lookup
+
+   subroutine compare_lookups(comm, dim)
+      type(MPI_Comm), intent(in) :: comm
+      integer, intent(in) :: dim
+      type(solver_t), target :: solver(2)
+      type(scene_t) :: scene
+      type(status_t) :: status
+      real(rp) :: largest, difference
+      integer :: i, step, n
+      character(len=2) :: label
+      label = merge('2D', '3D', dim == 2)
+      if (dim == 2) then
+         scene = water_scene(2, 0.1_rp, [2.0_rp, 1.2_rp, 0.0_rp], 2.0e6_rp, 10.0_rp)
+         call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [0.6_rp, 0.8_rp, 0.0_rp], 2, .true., 0.8_rp)
+         call add_body(scene, 1, [0.6_rp, 0.0_rp, 0.0_rp], [1.4_rp, 0.25_rp, 0.0_rp], 2, .true., 0.25_rp)
+      else
+         scene = water_scene(3, 0.1_rp, [1.2_rp, 0.4_rp, 0.8_rp], 2.0e6_rp, 10.0_rp)
+         call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [0.4_rp, 0.4_rp, 0.6_rp], 2, .true., 0.6_rp)
+         call add_body(scene, 1, [0.4_rp, 0.0_rp, 0.0_rp], [0.9_rp, 0.4_rp, 0.15_rp], 2, .true., 0.15_rp)
+      end if
+      scene%materials(1)%stabilization = 'FOAL1'
+      scene%materials(1)%volume_correction = 'shifting'
+      do i = 1, 2
+         call solver(i)%init(scene, comm, status)
+         call assertTrue(status%ok, label//': '//trim(status%message))
+         do step = 1, 15
+            call solver(i)%advance()
+         end do
+      end do
+      solver(2)%volume%lookup_per_column = .false.
+      do i = 1, 2
+         associate (s => solver(i))
+            call s%volume%prepare(s%domain, s%grid, s%walls, s%particles, int(s%volume%interval, i8))
+         end associate
+      end do
+      call assertTrue(solver(1)%volume%shifting_now .and. solver(1)%volume%surface_model, label//': an application')
+      n = solver(1)%particles%count
+      largest = 0.0_rp
+      difference = 0.0_rp
+      if (n > 0) then
+         largest = maxval(abs(solver(1)%volume%shift(:, 1:n)))
+         difference = maxval(abs(solver(1)%volume%shift(:, 1:n) - solver(2)%volume%shift(:, 1:n)))
+      end if
+      call MPI_Allreduce(MPI_IN_PLACE, largest, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+      call MPI_Allreduce(MPI_IN_PLACE, difference, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+      call assertTrue(largest > 0.0_rp, label//': particles shift')
+      call assertTrue(difference <= 0.0_rp, label//': the same shifts bit for bit, largest difference '// &
+                      real_text(difference)//' m')
+      do i = 1, 2
+         call solver(i)%free()
+      end do
+   end subroutine compare_lookups
 
    subroutine test_shifting_spreads_crowded_particles(comm)
       type(MPI_Comm), intent(in) :: comm
