@@ -200,9 +200,8 @@ contains
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(in) :: particles
       logical, intent(in) :: reliable(:)
-      real(rp), parameter :: clearly_shorter = 0.999_rp     ! squared length ratio: far above round-off
-      real(rp) :: length, scale, longest
-      integer :: m, p
+      real(rp) :: scale, longest
+      integer :: m
       if (allocated(self%shift)) then
          if (size(self%shift, 2) < particles%count) deallocate (self%shift)
       end if
@@ -214,16 +213,36 @@ contains
          call gradient_at_particles(grid, particles, particles%material_first(m), particles%material_last(m), &
                                     self%excess(1, :), reliable, self%shift)
          scale = -self%shifting_coefficient(m) * self%interval * grid%h**2
-         ! the cap: norm2 (scaled, a division per component) only where the plain sum of squares does not
-         ! show the shift clearly shorter (most particles move far less than the cap)
-         do p = particles%material_first(m), particles%material_last(m)
-            self%shift(:, p) = scale * self%shift(:, p)
-            if (sum(self%shift(:, p)**2) < clearly_shorter * longest**2) cycle
-            length = norm2(self%shift(:, p))
-            if (length > longest) self%shift(:, p) = self%shift(:, p) * (longest / length)
-         end do
+         ! literal dimensions: the loops over the components unroll (with the run-time one, 0.6 % of a run)
+         if (grid%dim == 2) then
+            call scale_and_cap(2, scale, longest, self%shift(:, particles%material_first(m):particles%material_last(m)))
+         else
+            call scale_and_cap(3, scale, longest, self%shift(:, particles%material_first(m):particles%material_last(m)))
+         end if
       end do
    end subroutine shifts_of_particles
+
+   !> shift := scale * shift, then at most `longest` long. The cap takes norm2 (scaled, a division per
+   !> component) only where the plain sum of squares does not show the shift clearly shorter (most particles
+   !> move far less than the cap); the sum in the order of sum(shift**2).
+   subroutine scale_and_cap(dim, scale, longest, shift)
+      integer, intent(in) :: dim
+      real(rp), intent(in) :: scale, longest
+      real(rp), intent(inout) :: shift(:, :)
+      real(rp), parameter :: clearly_shorter = 0.999_rp     ! squared length ratio: far above round-off
+      real(rp) :: length, squares
+      integer :: p, k
+      do p = 1, size(shift, 2)
+         squares = 0.0_rp
+         do k = 1, dim
+            shift(k, p) = scale * shift(k, p)
+            squares = squares + shift(k, p)**2
+         end do
+         if (squares < clearly_shorter * longest**2) cycle
+         length = norm2(shift(1:dim, p))
+         if (length > longest) shift(1:dim, p) = shift(1:dim, p) * (longest / length)
+      end do
+   end subroutine scale_and_cap
 
    !> After the position update of the step (particle order unchanged since prepare), for the particles
    !> first:last. A shifted particle takes the hydrostatic pressure of its new place, p := p + rho g . dx
@@ -233,17 +252,36 @@ contains
       class(volume_corrector_t), intent(in) :: self
       type(particle_set_t), intent(inout) :: particles
       integer, intent(in) :: first, last
-      integer :: m, p, dim
+      integer :: m, dim
       if (.not. self%shifting_now) return
       dim = particles%dim
       do m = 1, size(self%shifting_coefficient)
          if (self%shifting_coefficient(m) <= 0.0_rp) cycle
-         do p = max(first, particles%material_first(m)), min(last, particles%material_last(m))
-            particles%x(:, p) = particles%x(:, p) + self%shift(:, p)
-            ! sbar = -p/rho on the normal components: d(sbar) = -dp/rho = -g . dx
-            particles%sbar(1:3, p) = particles%sbar(1:3, p) - dot_product(self%gravity(1:dim), self%shift(:, p))
-         end do
+         ! literal dimensions: the loops over the components unroll
+         if (dim == 2) then
+            call shift_particles(2, max(first, particles%material_first(m)), min(last, particles%material_last(m)))
+         else
+            call shift_particles(3, max(first, particles%material_first(m)), min(last, particles%material_last(m)))
+         end if
       end do
+
+   contains
+
+      !> x_p += dx_p, and sbar = -p/rho on the normal components: d(sbar) = -dp/rho = -g . dx (the dot
+      !> product summed in the order of dot_product), for the particles lo..hi.
+      subroutine shift_particles(dim, lo, hi)
+         integer, intent(in) :: dim, lo, hi
+         real(rp) :: rise
+         integer :: p, k
+         do p = lo, hi
+            rise = 0.0_rp
+            do k = 1, dim
+               particles%x(k, p) = particles%x(k, p) + self%shift(k, p)
+               rise = rise + self%gravity(k) * self%shift(k, p)
+            end do
+            particles%sbar(1:3, p) = particles%sbar(1:3, p) - rise
+         end do
+      end subroutine shift_particles
    end subroutine corrector_apply_shifts
 
    !> After the stress update and smoothing: p := p + r (K ln(rho/rho_0) - p), deviatoric stress kept.
