@@ -213,7 +213,7 @@ contains
          call gradient_at_particles(grid, particles, particles%material_first(m), particles%material_last(m), &
                                     self%excess(1, :), reliable, self%shift)
          scale = -self%shifting_coefficient(m) * self%interval * grid%h**2
-         ! literal dimensions: the loops over the components unroll (with the run-time one, 0.6 % of a run)
+         ! literal dimensions: the loops over the components unroll (with the run-time one, 0.5 % of a run)
          if (grid%dim == 2) then
             call scale_and_cap(2, scale, longest, self%shift(:, particles%material_first(m):particles%material_last(m)))
          else
