@@ -468,10 +468,11 @@ contains
       type(volume_corrector_t), intent(inout) :: self
       type(grid_t), intent(in) :: grid
       type(wall_t), intent(in) :: walls(:)
-      integer, parameter :: max_columns = 16**2
-      integer :: dim, i, j, l, k, g(3), node, s(3), per_axis, first(2), last(2), nb(2), column
+      integer, parameter :: max_columns = (2 * maxval(surface_samples_per_cell))**2   ! per_axis**(dim - 1) at most
+      integer :: dim, i, j, l, k, g(3), node, s(3), per_axis, first(2), last(2), nb(2), column, l_sub
       real(rp) :: x_node(3), x(3), weight, sub, reach(2), rise, lowest, volume, extent(3), u, surface, share, &
-                  rise_of_part, half_depth, sub_volume, column_height(max_columns)
+                  rise_of_part, half_depth, sub_volume, column_height(max_columns), &
+                  sample_x(2 * maxval(surface_samples_per_cell), 3), axis_weight(2 * maxval(surface_samples_per_cell), 3)
       logical, allocatable :: counts(:)
       logical :: upright
 
@@ -487,7 +488,7 @@ contains
       do k = 1, dim - 1
          reach(k) = grid%h * sum(abs(self%horizontal(1:dim, k)))
       end do
-      upright = self%lookup_per_column .and. grid_axis_up(self, dim) .and. per_axis**(dim - 1) <= max_columns
+      upright = self%lookup_per_column .and. grid_axis_up(self, dim)
       x_node = 0.0_rp
       x = 0.0_rp
       first = 1
@@ -513,14 +514,22 @@ contains
                   self%fluid_volume(node) = 0.0_rp
                   cycle
                end if
-               if (upright) call column_heights(x_node, column_height)
+               ! per axis, the sub-cells' centres and N's factor there, for every sample of the node
+               do k = 1, dim
+                  do l_sub = 1, per_axis
+                     sample_x(l_sub, k) = x_node(k) + grid%h * (-1.0_rp + (real(l_sub, rp) - 0.5_rp) / &
+                                                                surface_samples_per_cell(dim))
+                     axis_weight(l_sub, k) = 1.0_rp - abs(sample_x(l_sub, k) - x_node(k)) * grid%inv_h
+                  end do
+               end do
+               if (upright) call column_heights(column_height)
                volume = 0.0_rp
                s = 1
                do
                   weight = sub_volume
                   do k = 1, dim
-                     x(k) = x_node(k) + grid%h * (-1.0_rp + (real(s(k), rp) - 0.5_rp) / surface_samples_per_cell(dim))
-                     weight = weight * (1.0_rp - abs(x(k) - x_node(k)) * grid%inv_h)
+                     x(k) = sample_x(s(k), k)
+                     weight = weight * axis_weight(s(k), k)
                   end do
                   if (upright) then
                      column = s(1)
@@ -557,8 +566,7 @@ contains
       !> The height function over each column of sub-cells of the support of the node at x_node (columns
       !> numbered as the samples' horizontal indices, the first fastest), as surface_over gives it at any
       !> sample of the column.
-      subroutine column_heights(x_node, height)
-         real(rp), intent(in) :: x_node(3)
+      subroutine column_heights(height)
          real(rp), intent(out) :: height(:)
          real(rp) :: x_column(3)
          integer :: c(2), column
@@ -568,7 +576,7 @@ contains
             c(1) = 1 + mod(column - 1, per_axis)
             c(2) = 1 + (column - 1) / per_axis
             do k = 1, dim - 1
-               x_column(k) = x_node(k) + grid%h * (-1.0_rp + (real(c(k), rp) - 0.5_rp) / surface_samples_per_cell(dim))
+               x_column(k) = sample_x(c(k), k)
             end do
             height(column) = surface_over(self, x_column, dim)
          end do
