@@ -12,6 +12,7 @@ module test_stabilization_consistency
    use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_split, MPI_Comm_free, MPI_Allreduce, MPI_Bcast, &
                       MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_SUM, MPI_UNDEFINED, MPI_COMM_NULL, operator(/=)
    use assertions, only: assertTrue, assertEqual
+   use reproducible_numbers, only: hash01
    use error_status, only: status_t
    use scene_description, only: scene_t
    use mpm_solver, only: solver_t
@@ -104,7 +105,7 @@ contains
       integer :: j
       do j = 1, n_sigma
          if (pattern == random_field) then
-            v(j) = 1.0e3_rp * (modulo(sin(real(id * 7 + j, rp) * 12.9898_rp) * 43758.5453_rp, 1.0_rp) - 0.5_rp)
+            v(j) = 1.0e3_rp * (hash01(id * 7 + j) - 0.5_rp)
          else
             v(j) = real((-1)**(sum(cell)), rp)
          end if

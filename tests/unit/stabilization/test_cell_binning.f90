@@ -5,6 +5,7 @@
 module test_cell_binning
    use kinds, only: rp, i8
    use assertions, only: assertEqual, assertTrue
+   use reproducible_numbers, only: hash01
    use particle_set, only: particle_set_t
    use cell_binning, only: cell_list_t, start_cell_list, bin_cell_mass, cell_average
    implicit none
@@ -16,12 +17,6 @@ module test_cell_binning
 
 contains
 
-   !> A reproducible pseudo-random number in [0, 1) from an integer.
-   pure real(rp) function hash01(i)
-      integer, intent(in) :: i
-      hash01 = modulo(sin(real(i, rp) * 12.9898_rp) * 43758.5453_rp, 1.0_rp)
-   end function hash01
-
    !> n_particles particles of dimension dim with random masses and stresses; cells in runs of 1 to 7
    !> particles over the first 50 cells, then 40 particles back in cells met before.
    function sample_particles(dim) result(particles)
@@ -30,8 +25,6 @@ contains
       integer :: p, k, cell, left_in_run
       real(rp) :: stress(6)
       call particles%init(dim, 1, n_particles)
-      cell = 1
-      left_in_run = 3
       do p = 1, n_particles
          stress = 1.0e3_rp * [hash01(7 * p), hash01(7 * p + 1), hash01(7 * p + 2), hash01(7 * p + 3), &
                               hash01(7 * p + 4), hash01(7 * p + 5)] - 500.0_rp
@@ -39,6 +32,7 @@ contains
                             1000.0_rp, stress(1:particles%n_sigma), 1, int(p, i8))
       end do
       cell = 1
+      left_in_run = 3
       do p = 1, n_particles
          if (p > n_particles - 40) then
             particles%cell(p) = 1 + int(50 * hash01(11 * p))

@@ -5,6 +5,7 @@
 module test_limited_flux_smoothing
    use kinds, only: rp
    use assertions, only: assertEqual, assertTrue
+   use reproducible_numbers, only: hash01
    use domain_decomposition, only: domain_t
    use background_grid, only: grid_t
    use cell_halo, only: padded_cells_t
@@ -75,26 +76,30 @@ contains
                                    workspace)
    end subroutine smooth
 
-   !> A reproducible pseudo-random number in [0, 1) from an integer.
-   pure real(rp) function hash01(i)
-      integer, intent(in) :: i
-      hash01 = modulo(sin(real(i, rp) * 12.9898_rp) * 43758.5453_rp, 1.0_rp)
-   end function hash01
+   !> Mass centres of every cell at reproducible random places inside it (5 % of h or more from its faces).
+   subroutine scatter_centres(cells, dim)
+      type(cells_t), intent(inout) :: cells
+      integer, intent(in) :: dim
+      integer :: c, k, g(3)
+      do c = 1, cells%box%count
+         g = global_cell(cells%box, c)
+         do k = 1, dim
+            cells%centre(k, c) = (g(k) + 0.05_rp + 0.9_rp * hash01(5 * c + k)) * h
+         end do
+      end do
+   end subroutine scatter_centres
 
    !> Random masses, mass centres inside the cells and values: sum_c m_c q^_c = sum_c m_c q_c.
    subroutine test_conservation_random_field()
       type(cells_t) :: cells
-      integer :: c, j, dim, k, g(3)
+      integer :: c, j, dim
       real(rp) :: before, after, scale
       do dim = 2, 3
          cells = uniform_cells(dim, [7, 6, 5], 4)
+         call scatter_centres(cells, dim)
          do c = 1, cells%box%count
             if (.not. cells%exists(c)) cycle
-            g = global_cell(cells%box, c)
             cells%mass(c) = h**dim * (0.1_rp + hash01(3 * c))
-            do k = 1, dim
-               cells%centre(k, c) = (g(k) + 0.05_rp + 0.9_rp * hash01(5 * c + k)) * h
-            end do
             do j = 1, 4
                cells%q(j, c) = 1.0e4_rp * (hash01(7 * c + j) - 0.5_rp)
             end do
@@ -275,12 +280,10 @@ contains
          nq = merge(4, 6, dim == 2)
          do rule = 1, 2
             cells = uniform_cells(dim, [9, 8, 7], nq)
+            call scatter_centres(cells, dim)
             do c = 1, cells%box%count
                g = global_cell(cells%box, c)
                cells%exists(c) = hash01(11 * c) > 0.15_rp     ! ghost cells too; about one cell in seven missing
-               do k = 1, dim
-                  cells%centre(k, c) = (g(k) + 0.05_rp + 0.9_rp * hash01(5 * c + k)) * h
-               end do
                cells%mass(c) = merge(h**dim * (0.1_rp + hash01(3 * c)), 0.0_rp, cells%exists(c))
                do j = 1, nq      ! a trend under noise: about half of the cells oscillate, along every axis
                   cells%q(j, c) = 10.0_rp * j * g(2) + 60.0_rp * (hash01(7 * c + j) - 0.5_rp)
@@ -324,11 +327,8 @@ contains
       do dim = 2, 3
          nq = merge(4, 6, dim == 2)
          wide = uniform_cells(dim, [9, 8, 7], nq)
+         call scatter_centres(wide, dim)
          do c = 1, wide%box%count
-            g = global_cell(wide%box, c)
-            do k = 1, dim
-               wide%centre(k, c) = (g(k) + 0.05_rp + 0.9_rp * hash01(5 * c + k)) * h
-            end do
             wide%q(:, c) = 60.0_rp * [(hash01(7 * c + k), k=1, nq)]
          end do
          ! the outer owned layer along axis 1 and the top one along the last axis empty, their masses and
