@@ -96,7 +96,7 @@ module mpm_solver
       !> per material: its scheme forms the filtered rate of deformation from the nodal velocities, and G2P
       !> forms no particle rates (see materials_taking_rate_from_grid)
       logical, allocatable :: rate_from_grid(:)
-      type(stencil_cache_t) :: stencils        !< the particles' stencils from P2G to G2P of a step (3-D)
+      type(stencil_cache_t) :: stencils        !< the particles' stencils at x^n, from P2G to G2P of a step (3-D)
       real(rp) :: extent(3, 2) = 0.0_rp         !< lowest and highest particle position after the last move
       integer :: relayouts = 0                  !< layouts made because the particles outgrew the active region
       !> the largest rank's particle count when the last layout search found no better layout (0: none since
@@ -455,7 +455,7 @@ contains
       call self%loads%begin_step(size(self%walls))
       if (self%volume%shifting) then
          call self%timers%switch_to(phase_volume_correction)
-         call self%volume%prepare(self%domain, self%grid, self%walls, self%particles, self%step)
+         call self%volume%prepare(self%domain, self%grid, self%walls, self%particles, self%step, self%stencils)
       end if
       context%domain => self%domain
       context%grid => self%grid

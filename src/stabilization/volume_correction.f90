@@ -39,6 +39,7 @@ module volume_correction
    use domain_decomposition, only: domain_t
    use background_grid, only: grid_t
    use grid_transfer, only: volume_to_grid, gradient_at_particles
+   use stencil_cache, only: stencil_cache_t
    use node_halo, only: sum_shared_nodes
    use particle_set, only: particle_set_t
    use boundary_walls, only: wall_t, wall_kind_prescribed, behind_wall
@@ -98,9 +99,12 @@ module volume_correction
       logical, allocatable :: wall_activity(:)      !< walls' activity V_i was measured with
       real(rp), allocatable :: excess(:, :)         !< (1, node): occupancy, then psi_i
       real(rp), allocatable :: shift(:, :)          !< (dim, p): displacement added after the position update
-      !> the surface cut looks the height up once per column of sub-cells where up is a grid axis (off: once per
-      !> sub-cell, the general way; the same volumes bit for bit, which a test checks)
-      logical :: lookup_per_column = .true.
+      !> shortcuts that give the same bits (a test compares them with the general way): where up is a grid axis
+      !> the surface cut looks the height up once per column of sub-cells, takes the lowest height once per
+      !> column of nodes and stops at the first row of sub-cells above the surface; the walls far from a
+      !> node are not tested at its samples; a cube root per run of particles of one mass and density; the
+      !> stencils of the occupancy's transfer kept for the gradient's (3-D). Off: the general way throughout
+      logical :: shortcuts = .true.
    contains
       procedure :: init => corrector_init
       procedure :: reset_grid => corrector_reset_grid
@@ -146,14 +150,16 @@ contains
    end subroutine corrector_reset_grid
 
    !> At x^n, before the step's particle-to-grid transfer: the shifts of step `step` (every interval-th
-   !> step; by the step number, so a restart keeps the rhythm). Collective.
-   subroutine corrector_prepare(self, domain, grid, walls, particles, step)
+   !> step; by the step number, so a restart keeps the rhythm). Collective. `stencils` (3-D): the occupancy's
+   !> transfer keeps the particles' stencils there for the gradient's (src/transfer/stencil_cache.f90).
+   subroutine corrector_prepare(self, domain, grid, walls, particles, step, stencils)
       class(volume_corrector_t), intent(inout) :: self
       type(domain_t), intent(in) :: domain
       type(grid_t), intent(in) :: grid
       type(wall_t), intent(in) :: walls(:)
       type(particle_set_t), intent(inout) :: particles
       integer(i8), intent(in) :: step
+      type(stencil_cache_t), intent(inout), optional :: stencils
       integer :: i
       real(rp) :: threshold
 
@@ -171,7 +177,11 @@ contains
 
       call equalize_cell_volumes(self, grid, particles)
       self%excess = 0.0_rp
-      call volume_to_grid(grid, particles, self%excess(1, :))
+      if (self%shortcuts .and. present(stencils)) then
+         call volume_to_grid(grid, particles, self%excess(1, :), stencils)
+      else
+         call volume_to_grid(grid, particles, self%excess(1, :))
+      end if
       call sum_shared_nodes(domain, grid, self%excess)
       self%fluid_volume = self%open_volume
       if (self%surface_model) then
@@ -188,18 +198,20 @@ contains
       end do
       ! a node cut by the free surface to a sliver is empty (psi = 0: crowding below may push into it);
       ! one cut by walls to a sliver is unknown (the particle's own excess: walls neither sink nor source)
-      call shifts_of_particles(self, grid, particles, self%open_volume >= threshold)
+      ! (the stencils hold the particles only if volume_to_grid kept them: else the gradient locates them)
+      call shifts_of_particles(self, grid, particles, self%open_volume >= threshold, stencils)
    end subroutine corrector_prepare
 
    !> dx_p = -D h^2 sum_a grad N_a psi_a for the particles of shifting materials, at most 0.1 h long.
    !> A node mostly closed by walls has no reliable occupancy: it takes the particle's own excess (the
    !> N-weighted mean over the reliable corners), so a wall is neither a sink nor a source (zero normal
    !> gradient), where psi = 0 would pull particles onto it.
-   subroutine shifts_of_particles(self, grid, particles, reliable)
+   subroutine shifts_of_particles(self, grid, particles, reliable, stencils)
       type(volume_corrector_t), intent(inout) :: self
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(in) :: particles
       logical, intent(in) :: reliable(:)
+      type(stencil_cache_t), intent(in), optional :: stencils
       real(rp) :: scale, longest
       integer :: m
       if (allocated(self%shift)) then
@@ -211,7 +223,7 @@ contains
          if (self%shifting_coefficient(m) <= 0.0_rp) cycle
          if (particles%material_last(m) < particles%material_first(m)) cycle
          call gradient_at_particles(grid, particles, particles%material_first(m), particles%material_last(m), &
-                                    self%excess(1, :), reliable, self%shift)
+                                    self%excess(1, :), reliable, self%shift, stencils)
          scale = -self%shifting_coefficient(m) * self%interval * grid%h**2
          ! literal dimensions: the loops over the components unroll (with the run-time one, 0.5 % of a run)
          if (grid%dim == 2) then
@@ -379,7 +391,8 @@ contains
       type(particle_set_t), intent(in) :: particles
       integer, parameter :: block_size = 256
       integer :: dim, k, p, corner, n(2), first(2, block_size), last(2, block_size), i, j, b, e
-      real(rp) :: box_hi(3), x(3), u, lo(2), hi(2), top(block_size), third
+      real(rp) :: box_hi(3), x(3), u, lo(2), hi(2), top(block_size), third, width, width_mass, width_density, &
+                  widths(block_size)
 
       dim = grid%dim
       self%bin_width = grid%h / bins_per_cell(dim)
@@ -409,6 +422,9 @@ contains
       ! per block: the tops and bin ranges in a loop without stores to the bins (it vectorises in 2-D:
       ! sqrt and the divisions 8 particles at a time), then the maxima bin by bin
       third = 1.0_rp / 3.0_rp
+      width_mass = -1.0_rp      ! no particle's: the first 3-D particle takes its cube root
+      width_density = -1.0_rp
+      width = 0.0_rp
       do b = 1, particles%count, block_size
          e = min(particles%count, b + block_size - 1)
          if (dim == 2) then
@@ -418,9 +434,21 @@ contains
             end do
          else
             do p = b, e
-               ! dim, not the literal 3: the literal changes the dot products' multiply-adds (last bits)
-               call particle_reach(dim, (particles%mass(p) / particles%density(p))**third, particles%x(1:3, p), &
-                                   top(p - b + 1), first(:, p - b + 1), last(:, p - b + 1))
+               ! the cube root (a call of pow) once per run of particles of equal mass and density: after
+               ! equalize_cell_volumes the particles of a cell share their density, and lattices their mass
+               if (.not. (self%shortcuts .and. abs(particles%mass(p) - width_mass) <= 0.0_rp .and. &
+                          abs(particles%density(p) - width_density) <= 0.0_rp)) then   ! (a NaN takes its own)
+                  width_mass = particles%mass(p)
+                  width_density = particles%density(p)
+                  width = (width_mass / width_density)**third
+               end if
+               widths(p - b + 1) = width
+            end do
+            ! the reaches in a loop of their own, which vectorises with the literal 3 (the divisions by the bin
+            ! width 8 particles at a time)
+            do p = b, e
+               call particle_reach(3, widths(p - b + 1), particles%x(1:3, p), top(p - b + 1), first(:, p - b + 1), &
+                                   last(:, p - b + 1))
             end do
          end if
          do p = 1, e - b + 1
@@ -471,10 +499,15 @@ contains
       integer, parameter :: max_columns = (2 * maxval(surface_samples_per_cell))**2   ! per_axis**(dim - 1) at most
       integer :: dim, i, j, l, k, g(3), node, s(3), per_axis, first(2), last(2), nb(2), column, l_sub
       real(rp) :: x_node(3), x(3), weight, sub, reach(2), rise, lowest, volume, extent(3), u, surface, share, &
-                  rise_of_part, half_depth, sub_volume, column_height(max_columns), &
+                  rise_of_part, half_depth, sub_volume, column_height(max_columns), highest, &
                   sample_x(2 * maxval(surface_samples_per_cell), 3), axis_weight(2 * maxval(surface_samples_per_cell), 3)
-      logical, allocatable :: counts(:)
+      logical, allocatable :: counts(:), near(:)
       logical :: upright
+      ! upright: the lowest height over the support of each column of nodes (horizontal node indices; the
+      ! second is 0 in 2-D), taken when a node of the column first needs it (column_known)
+      real(rp), allocatable :: column_lowest(:, :)
+      logical, allocatable :: column_known(:, :)
+      integer :: horizontal_node(2), second(2)
 
       dim = grid%dim
       counts = walls%active .and. walls%kind /= wall_kind_prescribed
@@ -488,7 +521,15 @@ contains
       do k = 1, dim - 1
          reach(k) = grid%h * sum(abs(self%horizontal(1:dim, k)))
       end do
-      upright = self%lookup_per_column .and. grid_axis_up(self, dim)
+      upright = self%shortcuts .and. grid_axis_up(self, dim)
+      if (upright) then
+         second = [0, 0]
+         if (dim == 3) second = [grid%node_lo(2), grid%node_hi(2)]
+         allocate (column_lowest(grid%node_lo(1):grid%node_hi(1), second(1):second(2)), &
+                   column_known(grid%node_lo(1):grid%node_hi(1), second(1):second(2)))
+         column_known = .false.
+      end if
+      horizontal_node = 0
       x_node = 0.0_rp
       x = 0.0_rp
       first = 1
@@ -501,12 +542,19 @@ contains
                ! no particle in the support: phi = 0 whatever V_i is
                if (self%open_volume(node) <= 0.0_rp .or. self%excess(1, node) <= 0.0_rp) cycle
                x_node(1:dim) = grid%origin(1:dim) + g(1:dim) * grid%h
-               do k = 1, dim - 1
-                  u = dot_product(x_node(1:dim), self%horizontal(1:dim, k)) - self%bin_lo(k)
-                  first(k) = max(1, 1 + floor((u - reach(k)) / self%bin_width))
-                  last(k) = min(nb(k), 1 + floor((u + reach(k)) / self%bin_width))
-               end do
-               lowest = minval(self%surface_height(first(1):last(1), first(2):last(2)))
+               if (upright) then
+                  ! the bins over the support are those of every node of the column (x . horizontal is x's own
+                  ! coordinate): one minimum per column, not one per node
+                  horizontal_node(1:dim - 1) = g(1:dim - 1)
+                  associate (known => column_known(horizontal_node(1), horizontal_node(2)), &
+                             column_min => column_lowest(horizontal_node(1), horizontal_node(2)))
+                     if (.not. known) column_min = lowest_over_support()
+                     known = .true.
+                     lowest = column_min
+                  end associate
+               else
+                  lowest = lowest_over_support()
+               end if
                if (lowest >= dot_product(x_node(1:dim), self%up(1:dim)) + rise) cycle   ! wholly below
                ! a node above the surface is in the air: psi = 0 there, so the crowding of the layer under
                ! the surface drains through it (a zero excess on the surface itself, where a node rarely is)
@@ -522,10 +570,23 @@ contains
                      axis_weight(l_sub, k) = 1.0_rp - abs(sample_x(l_sub, k) - x_node(k)) * grid%inv_h
                   end do
                end do
-               if (upright) call column_heights(column_height)
+               if (.not. self%fully_open(node)) then
+                  near = counts
+                  if (self%shortcuts) near = walls_near(grid, walls, counts, x_node)
+               end if
+               if (upright) then
+                  call column_heights(column_height)
+                  highest = maxval(column_height(1:per_axis**(dim - 1)))
+               end if
                volume = 0.0_rp
                s = 1
                do
+                  ! upright: the samples go up row by row; a row whose bottom is above the highest column
+                  ! (rounding is monotone, so no sample of it passes the test below) and those after it add
+                  ! nothing
+                  if (upright .and. all(s(1:dim - 1) == 1)) then
+                     if (highest - sample_x(s(dim), dim) <= -half_depth) exit
+                  end if
                   weight = sub_volume
                   do k = 1, dim
                      x(k) = sample_x(s(k), k)
@@ -550,7 +611,7 @@ contains
                      end if
                      weight = weight * share
                      if (weight > 0.0_rp) then
-                        if (.not. self%fully_open(node)) weight = weight * open_fraction(grid, walls, counts, x)
+                        if (.not. self%fully_open(node)) weight = weight * open_fraction(grid, walls, near, x)
                         volume = volume + weight
                      end if
                   end if
@@ -562,6 +623,17 @@ contains
       end do
 
    contains
+
+      !> The lowest height function over the bins the support of the node at x_node spans horizontally
+      !> (no_surface if a bin has no particle over it).
+      real(rp) function lowest_over_support() result(lowest)
+         do k = 1, dim - 1
+            u = dot_product(x_node(1:dim), self%horizontal(1:dim, k)) - self%bin_lo(k)
+            first(k) = max(1, 1 + floor((u - reach(k)) / self%bin_width))
+            last(k) = min(nb(k), 1 + floor((u + reach(k)) / self%bin_width))
+         end do
+         lowest = minval(self%surface_height(first(1):last(1), first(2):last(2)))
+      end function lowest_over_support
 
       !> The height function over each column of sub-cells of the support of the node at x_node (columns
       !> numbered as the samples' horizontal indices, the first fastest), as surface_over gives it at any
@@ -669,7 +741,7 @@ contains
       type(wall_t), intent(in) :: walls(:)
       integer :: dim, i, j, l, g(3), node, s(3), per_axis, k
       real(rp) :: x_node(3), x(3), weight, unit_weight, top(3), reach
-      logical, allocatable :: counts(:)
+      logical, allocatable :: counts(:), near(:)
 
       dim = grid%dim
       self%wall_activity = walls%active
@@ -694,6 +766,8 @@ contains
                   cycle
                end if
                self%open_volume(node) = 0.0_rp
+               near = counts
+               if (self%shortcuts) near = walls_near(grid, walls, counts, x_node)
                s = 1
                do
                   ! sample point at the midpoint of sub-cell s, and its weight N_i(x)
@@ -702,7 +776,7 @@ contains
                      x(k) = x_node(k) + grid%h * (-1.0_rp + (real(s(k), rp) - 0.5_rp) / samples_per_cell(dim))
                      weight = weight * (1.0_rp - abs(x(k) - x_node(k)) * grid%inv_h)
                   end do
-                  self%open_volume(node) = self%open_volume(node) + weight * open_fraction(grid, walls, counts, x)
+                  self%open_volume(node) = self%open_volume(node) + weight * open_fraction(grid, walls, near, x)
                   if (.not. next_sample(s, dim, per_axis)) exit
                end do
             end do
@@ -726,6 +800,33 @@ contains
          end do
       end function support_is_open
    end subroutine measure_open_volumes
+
+   !> The counted walls that may cut the support [x_node - h, x_node + h]^dim: open_fraction skips every other
+   !> one at every sample of the support, so with these alone it gives the same fractions. A planar wall is
+   !> left out where the node lies farther in front of it than the support reaches (and the on-wall
+   !> tolerance), or farther behind than its depth and two reaches (open_fraction widens the depth by one);
+   !> a margin of 1e-6 h, far above the rounding of a distance, keeps the decision off the edge. A
+   !> structure's surface always counts. Most nodes near the walls are near one of them: the box's other
+   !> walls no longer cost a test per sample.
+   function walls_near(grid, walls, counts, x_node) result(near)
+      type(grid_t), intent(in) :: grid
+      type(wall_t), intent(in) :: walls(:)
+      logical, intent(in) :: counts(:)
+      real(rp), intent(in) :: x_node(3)
+      logical :: near(size(walls))
+      real(rp) :: reach, margin, distance
+      integer :: ww, dim
+      dim = grid%dim
+      reach = sqrt(real(dim, rp)) * grid%h
+      margin = 1.0e-6_rp * grid%h
+      do ww = 1, size(walls)
+         near(ww) = counts(ww)
+         if (.not. near(ww) .or. walls(ww)%shaped) cycle
+         distance = dot_product(walls(ww)%normal(1:dim), x_node(1:dim) - walls(ww)%point(1:dim))
+         near(ww) = distance <= reach + on_wall_tolerance * grid%h + margin .and. &
+                    distance >= -(walls(ww)%depth + 2.0_rp * reach) - margin
+      end do
+   end function walls_near
 
    !> 1 if the sample x is open, 0 if it is behind a counted wall or outside the grid box, 1/2 if it
    !> lies on a wall (a wall through the node at 45 degrees passes through samples: half is exact).

@@ -10,8 +10,10 @@
 !>    volumes, J and stress unchanged), rises back by more than half the drop, and stays pressed without
 !>    the correction; 2-D and 3-D;
 !>  - the sub-cell fraction under a surface plane is exact (box cut by a plane: known areas and volumes);
-!>  - the surface cut's height lookup once per column of sub-cells gives the lookup per sub-cell's shifts,
-!>    bit for bit, under a free surface that is not flat (2-D and 3-D);
+!>  - the corrector's shortcuts (height lookups and minima per column, rows above the surface skipped, walls
+!>    far from a node left out, cube roots per run, kept stencils) give the general way's open volumes,
+!>    fluid volumes and shifts, bit for bit, under a free surface that is not flat and beside an inclined
+!>    wall (2-D and 3-D); the stencils kept by the occupancy's transfer give the gradient of located ones;
 !>  - eos_relaxation starts a hydrostatic fluid in its EOS state p = K ln(rho/rho_0) and, at rate 1,
 !>    puts every particle's pressure back on it after each step.
 module test_volume_correction
@@ -19,7 +21,7 @@ module test_volume_correction
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_MAX
    use assertions, only: assertTrue, assertRelativelyEqual
    use error_status, only: status_t
-   use scene_description, only: scene_t
+   use scene_description, only: scene_t, wall_spec_t
    use mpm_solver, only: solver_t
    use particle_set, only: particle_set_t
    use particle_sorting, only: set_material_ranges
@@ -27,13 +29,16 @@ module test_volume_correction
    use run_diagnostics, only: diagnostics_t
    use test_scenes, only: water_scene, add_body
    use input_text, only: real_text
+   use grid_transfer, only: gradient_at_particles
+   use stencil_cache, only: holds_stencils
+   use reproducible_numbers, only: hash01
    implicit none
    private
 
    public :: test_shifting_leaves_a_filled_tank_alone, test_shifting_spreads_crowded_particles, &
              test_eos_relaxation_keeps_the_eos_state, test_shift_takes_the_hydrostatic_pressure, &
              test_shifting_lifts_a_crowded_surface_layer, test_fraction_below_a_plane, &
-             test_column_lookup_is_the_sub_cell_lookup
+             test_shortcuts_are_the_general_way
 
 contains
 
@@ -119,33 +124,40 @@ contains
       call add_body(scene, 1, [0.5_rp, 0.2_rp, 0.0_rp], [1.5_rp, 0.8_rp, 0.0_rp], 2, .false., 0.0_rp)
    end function crowded_scene
 
-   !> A dam break (a water column beside a lower layer, so the surface has a step and then slopes) run a few
-   !> steps by two identical solvers; then the shifts of one application with the height looked up per
-   !> column of sub-cells and per sub-cell: the same, bit for bit, and not zero.
-   subroutine test_column_lookup_is_the_sub_cell_lookup(comm)
+   !> A dam break (a water column beside a lower layer, so the surface has a step and then slopes) with an
+   !> inclined wall beyond the layer (a beach: it cuts supports at angles to the grid), run a few steps by two
+   !> identical solvers; then one application each, with the corrector's shortcuts and the general way
+   !> (volume_corrector_t%shortcuts): the same open volumes, fluid volumes and shifts, bit for bit, and
+   !> shifts not zero; and with the stencils the first kept, the gradient of a field varying along every
+   !> axis is that with the stencils located again.
+   subroutine test_shortcuts_are_the_general_way(comm)
       type(MPI_Comm), intent(in) :: comm
-      call compare_lookups(comm, 2)
-      call compare_lookups(comm, 3)
-   end subroutine test_column_lookup_is_the_sub_cell_lookup
+      call compare_shortcuts(comm, 2)
+      call compare_shortcuts(comm, 3)
+   end subroutine test_shortcuts_are_the_general_way
 
-   subroutine compare_lookups(comm, dim)
+   subroutine compare_shortcuts(comm, dim)
       type(MPI_Comm), intent(in) :: comm
       integer, intent(in) :: dim
       type(solver_t), target :: solver(2)
       type(scene_t) :: scene
       type(status_t) :: status
-      real(rp) :: largest, difference
-      integer :: i, step, n
+      real(rp) :: largest, difference(4), cut_supports
+      real(rp), allocatable :: field(:), kept(:, :), located(:, :)
+      logical, allocatable :: known(:)
+      integer :: i, step, n, node
       character(len=2) :: label
       label = merge('2D', '3D', dim == 2)
       if (dim == 2) then
          scene = water_scene(2, 0.1_rp, [2.0_rp, 1.2_rp, 0.0_rp], 2.0e6_rp, 10.0_rp)
          call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [0.6_rp, 0.8_rp, 0.0_rp], 2, .true., 0.8_rp)
          call add_body(scene, 1, [0.6_rp, 0.0_rp, 0.0_rp], [1.4_rp, 0.25_rp, 0.0_rp], 2, .true., 0.25_rp)
+         scene%walls = [beach([1.53_rp, 0.0_rp, 0.0_rp], [-1.0_rp, 0.7_rp, 0.0_rp])]
       else
          scene = water_scene(3, 0.1_rp, [1.2_rp, 0.4_rp, 0.8_rp], 2.0e6_rp, 10.0_rp)
          call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [0.4_rp, 0.4_rp, 0.6_rp], 2, .true., 0.6_rp)
          call add_body(scene, 1, [0.4_rp, 0.0_rp, 0.0_rp], [0.9_rp, 0.4_rp, 0.15_rp], 2, .true., 0.15_rp)
+         scene%walls = [beach([0.97_rp, 0.0_rp, 0.0_rp], [-1.0_rp, 0.3_rp, 0.8_rp])]
       end if
       scene%materials(1)%stabilization = 'FOAL1'
       scene%materials(1)%volume_correction = 'shifting'
@@ -156,10 +168,11 @@ contains
             call solver(i)%advance()
          end do
       end do
-      solver(2)%volume%lookup_per_column = .false.
+      solver(2)%volume%shortcuts = .false.
       do i = 1, 2
          associate (s => solver(i))
-            call s%volume%prepare(s%domain, s%grid, s%walls, s%particles, int(s%volume%interval, i8))
+            call s%volume%reset_grid()       ! the open volumes measured again, each way
+            call s%volume%prepare(s%domain, s%grid, s%walls, s%particles, int(s%volume%interval, i8), s%stencils)
          end associate
       end do
       call assertTrue(solver(1)%volume%shifting_now .and. solver(1)%volume%surface_model, label//': an application')
@@ -168,17 +181,51 @@ contains
       difference = 0.0_rp
       if (n > 0) then
          largest = maxval(abs(solver(1)%volume%shift(:, 1:n)))
-         difference = maxval(abs(solver(1)%volume%shift(:, 1:n) - solver(2)%volume%shift(:, 1:n)))
+         difference(1) = maxval(abs(solver(1)%volume%shift(:, 1:n) - solver(2)%volume%shift(:, 1:n)))
       end if
+      difference(2) = maxval(abs(solver(1)%volume%open_volume - solver(2)%volume%open_volume))
+      difference(3) = maxval(abs(solver(1)%volume%fluid_volume - solver(2)%volume%fluid_volume))
+      cut_supports = count(.not. solver(1)%volume%fully_open)
+      call MPI_Allreduce(MPI_IN_PLACE, cut_supports, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+      ! the stencils kept by the occupancy's transfer (3-D) against located ones, for a nodal field that
+      ! varies along every axis (the excess of this scene hardly varies across its layers)
+      call assertTrue(holds_stencils(solver(1)%stencils, n) .eqv. dim == 3, label//': stencils kept in 3-D only')
+      associate (grid => solver(1)%grid)
+         allocate (field(grid%node_count), known(grid%node_count), kept(dim, n), located(dim, n))
+         do node = 1, grid%node_count
+            field(node) = hash01(node)
+            known(node) = hash01(node + grid%node_count) > 0.2_rp
+         end do
+         call gradient_at_particles(grid, solver(1)%particles, 1, n, field, known, kept, solver(1)%stencils)
+         call gradient_at_particles(grid, solver(1)%particles, 1, n, field, known, located)
+      end associate
+      difference(4) = 0.0_rp
+      if (n > 0) difference(4) = maxval(abs(kept - located))
       call MPI_Allreduce(MPI_IN_PLACE, largest, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
-      call MPI_Allreduce(MPI_IN_PLACE, difference, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+      call MPI_Allreduce(MPI_IN_PLACE, difference, 4, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
       call assertTrue(largest > 0.0_rp, label//': particles shift')
-      call assertTrue(difference <= 0.0_rp, label//': the same shifts bit for bit, largest difference '// &
-                      real_text(difference)//' m')
+      call assertTrue(cut_supports > 0.0_rp, label//': walls cut some supports')
+      call assertTrue(difference(1) <= 0.0_rp, label//': the same shifts bit for bit, largest difference '// &
+                      real_text(difference(1))//' m')
+      call assertTrue(difference(2) <= 0.0_rp, label//': the same open volumes bit for bit, largest difference '// &
+                      real_text(difference(2))//' m^dim')
+      call assertTrue(difference(3) <= 0.0_rp, label//': the same fluid volumes bit for bit, largest difference '// &
+                      real_text(difference(3))//' m^dim')
+      call assertTrue(difference(4) <= 0.0_rp, label//': kept stencils give the located gradient bit for bit, '// &
+                      'largest difference '//real_text(difference(4)))
       do i = 1, 2
          call solver(i)%free()
       end do
-   end subroutine compare_lookups
+   contains
+      !> An unbounded slip wall through `point` with inward normal `normal` (world frame).
+      type(wall_spec_t) function beach(point, normal)
+         real(rp), intent(in) :: point(3), normal(3)
+         beach%point = point
+         beach%normal = normal
+         beach%moment_point = point
+         beach%name = 'beach'
+      end function beach
+   end subroutine compare_shortcuts
 
    subroutine test_shifting_spreads_crowded_particles(comm)
       type(MPI_Comm), intent(in) :: comm
