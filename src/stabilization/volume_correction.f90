@@ -497,7 +497,7 @@ contains
       type(grid_t), intent(in) :: grid
       type(wall_t), intent(in) :: walls(:)
       integer, parameter :: max_columns = (2 * maxval(surface_samples_per_cell))**2   ! per_axis**(dim - 1) at most
-      integer :: dim, i, j, l, k, g(3), node, s(3), per_axis, first(2), last(2), nb(2), column, l_sub
+      integer :: dim, i, j, l, k, g(3), node, s(3), per_axis, first(2), last(2), nb(2), column
       real(rp) :: x_node(3), x(3), weight, sub, reach(2), rise, lowest, volume, extent(3), u, surface, share, &
                   rise_of_part, half_depth, sub_volume, column_height(max_columns), highest, &
                   sample_x(2 * maxval(surface_samples_per_cell), 3), axis_weight(2 * maxval(surface_samples_per_cell), 3)
@@ -562,14 +562,7 @@ contains
                   self%fluid_volume(node) = 0.0_rp
                   cycle
                end if
-               ! per axis, the sub-cells' centres and N's factor there, for every sample of the node
-               do k = 1, dim
-                  do l_sub = 1, per_axis
-                     sample_x(l_sub, k) = x_node(k) + grid%h * (-1.0_rp + (real(l_sub, rp) - 0.5_rp) / &
-                                                                surface_samples_per_cell(dim))
-                     axis_weight(l_sub, k) = 1.0_rp - abs(sample_x(l_sub, k) - x_node(k)) * grid%inv_h
-                  end do
-               end do
+               call support_samples(grid, x_node, surface_samples_per_cell(dim), sample_x, axis_weight)
                if (.not. self%fully_open(node)) then
                   near = counts
                   if (self%shortcuts) near = walls_near(grid, walls, counts, x_node)
@@ -740,7 +733,8 @@ contains
       type(grid_t), intent(in) :: grid
       type(wall_t), intent(in) :: walls(:)
       integer :: dim, i, j, l, g(3), node, s(3), per_axis, k
-      real(rp) :: x_node(3), x(3), weight, unit_weight, top(3), reach
+      real(rp) :: x_node(3), x(3), weight, unit_weight, top(3), reach, sample_x(2 * maxval(samples_per_cell), 3), &
+                  axis_weight(2 * maxval(samples_per_cell), 3)
       logical, allocatable :: counts(:), near(:)
 
       dim = grid%dim
@@ -768,13 +762,14 @@ contains
                self%open_volume(node) = 0.0_rp
                near = counts
                if (self%shortcuts) near = walls_near(grid, walls, counts, x_node)
+               call support_samples(grid, x_node, samples_per_cell(dim), sample_x, axis_weight)
                s = 1
                do
                   ! sample point at the midpoint of sub-cell s, and its weight N_i(x)
                   weight = unit_weight
                   do k = 1, dim
-                     x(k) = x_node(k) + grid%h * (-1.0_rp + (real(s(k), rp) - 0.5_rp) / samples_per_cell(dim))
-                     weight = weight * (1.0_rp - abs(x(k) - x_node(k)) * grid%inv_h)
+                     x(k) = sample_x(s(k), k)
+                     weight = weight * axis_weight(s(k), k)
                   end do
                   self%open_volume(node) = self%open_volume(node) + weight * open_fraction(grid, walls, near, x)
                   if (.not. next_sample(s, dim, per_axis)) exit
@@ -800,6 +795,23 @@ contains
          end do
       end function support_is_open
    end subroutine measure_open_volumes
+
+   !> The samples of the support [x_node - h, x_node + h]^dim of a node, `per_cell` per cell and axis: along
+   !> each axis k, sample_x(l, k) the centre of the l-th sub-cell and axis_weight(l, k) N's factor there
+   !> (1 - |x - x_node| / h), so a sample's N_i is the product of its axes' factors.
+   pure subroutine support_samples(grid, x_node, per_cell, sample_x, axis_weight)
+      type(grid_t), intent(in) :: grid
+      real(rp), intent(in) :: x_node(3)
+      integer, intent(in) :: per_cell
+      real(rp), intent(out) :: sample_x(:, :), axis_weight(:, :)
+      integer :: k, l
+      do k = 1, grid%dim
+         do l = 1, 2 * per_cell
+            sample_x(l, k) = x_node(k) + grid%h * (-1.0_rp + (real(l, rp) - 0.5_rp) / per_cell)
+            axis_weight(l, k) = 1.0_rp - abs(sample_x(l, k) - x_node(k)) * grid%inv_h
+         end do
+      end do
+   end subroutine support_samples
 
    !> The counted walls that may cut the support [x_node - h, x_node + h]^dim: open_fraction skips every other
    !> one at every sample of the support, so with these alone it gives the same fractions. A planar wall is
