@@ -433,6 +433,9 @@ contains
                                    top(p - b + 1), first(:, p - b + 1), last(:, p - b + 1))
             end do
          else
+            ! scalar: vectorised (the general way, shortcuts off, has no recurrence) gcc would take libmvec's
+            ! vector pow, whose results need not be the scalar pow's bits
+            !GCC$ novector
             do p = b, e
                ! the cube root (a call of pow) once per run of particles of equal mass and density: after
                ! equalize_cell_volumes the particles of a cell share their density, and lattices their mass
