@@ -566,10 +566,7 @@ contains
                   cycle
                end if
                call support_samples(grid, x_node, surface_samples_per_cell(dim), sample_x, axis_weight)
-               if (.not. self%fully_open(node)) then
-                  near = counts
-                  if (self%shortcuts) near = walls_near(grid, walls, counts, x_node)
-               end if
+               if (.not. self%fully_open(node)) near = walls_near(self, grid, walls, counts, x_node)
                if (upright) then
                   call column_heights(column_height)
                   highest = maxval(column_height(1:per_axis**(dim - 1)))
@@ -763,8 +760,7 @@ contains
                   cycle
                end if
                self%open_volume(node) = 0.0_rp
-               near = counts
-               if (self%shortcuts) near = walls_near(grid, walls, counts, x_node)
+               near = walls_near(self, grid, walls, counts, x_node)
                call support_samples(grid, x_node, samples_per_cell(dim), sample_x, axis_weight)
                s = 1
                do
@@ -822,8 +818,9 @@ contains
    !> tolerance), or farther behind than its depth and two reaches (open_fraction widens the depth by one);
    !> a margin of 1e-6 h, far above the rounding of a distance, keeps the decision off the edge. A
    !> structure's surface always counts. Most nodes near the walls are near one of them: the box's other
-   !> walls no longer cost a test per sample.
-   function walls_near(grid, walls, counts, x_node) result(near)
+   !> walls no longer cost a test per sample. Without the shortcuts: every counted wall.
+   function walls_near(self, grid, walls, counts, x_node) result(near)
+      type(volume_corrector_t), intent(in) :: self
       type(grid_t), intent(in) :: grid
       type(wall_t), intent(in) :: walls(:)
       logical, intent(in) :: counts(:)
@@ -834,8 +831,9 @@ contains
       dim = grid%dim
       reach = sqrt(real(dim, rp)) * grid%h
       margin = 1.0e-6_rp * grid%h
+      near = counts
+      if (.not. self%shortcuts) return
       do ww = 1, size(walls)
-         near(ww) = counts(ww)
          if (.not. near(ww) .or. walls(ww)%shaped) cycle
          distance = dot_product(walls(ww)%normal(1:dim), x_node(1:dim) - walls(ww)%point(1:dim))
          near(ww) = distance <= reach + on_wall_tolerance * grid%h + margin .and. &
