@@ -455,7 +455,7 @@ contains
       call self%loads%begin_step(size(self%walls))
       if (self%volume%shifting) then
          call self%timers%switch_to(phase_volume_correction)
-         call self%volume%prepare(self%domain, self%grid, self%walls, self%particles, self%step, self%stencils)
+         call self%volume%prepare(self%domain, self%grid, self%walls, self%particles, self%step)
       end if
       context%domain => self%domain
       context%grid => self%grid
@@ -485,6 +485,11 @@ contains
       end if
       call self%timers%switch_to(phase_halo)
       call sum_shared_nodes(self%domain, self%grid, self%grid%accumulated)
+      if (self%volume%shifting_now) then
+         ! the occupancy and the shifts at x^n, with the transfer's stencils
+         call self%timers%switch_to(phase_volume_correction)
+         call self%volume%measure_excess(self%domain, self%grid, self%walls, self%particles, self%stencils)
+      end if
       call self%timers%switch_to(phase_grid_update)
       call update_nodes(self, dt)
 

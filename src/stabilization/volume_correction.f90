@@ -28,9 +28,11 @@
 !>                   then no longer drain the pressure. Seeding and inflow start such fluids at
 !>                   rho = rho_0 exp(p/K), so that the hydrostatic state is an EOS state.
 !>
-!> The occupancy uses the particles of all materials (a solid also fills space), at x^n, before the step's
-!> particle-to-grid transfer; the shifts are added after the position update, so the wall safeguard and
-!> the migration of the step see them. Costs nothing without a fluid that selects it.
+!> The occupancy uses the particles of all materials (a solid also fills space), at x^n: the volumes are
+!> equalised and the surface measured before the step's particle-to-grid transfer (prepare), the occupancy
+!> and the shifts follow it (measure_excess), reading its stencils (3-D). The shifts are added after the
+!> position update, so the wall safeguard and the migration of the step see them. Costs nothing without a
+!> fluid that selects it.
 module volume_correction
    use kinds, only: rp, i8
    use communication_counters, only: count_collective, comm_volume, real_bytes
@@ -103,12 +105,13 @@ module volume_correction
       !> the surface cut looks the height up once per column of sub-cells, takes the lowest height once per
       !> column of nodes and stops at the first row of sub-cells above the surface; the walls far from a
       !> node are not tested at its samples; a cube root per run of particles of one mass and density; the
-      !> stencils of the occupancy's transfer kept for the gradient's (3-D). Off: the general way throughout
+      !> occupancy's and the gradients' transfers read P2G's stencils (3-D). Off: the general way throughout
       logical :: shortcuts = .true.
    contains
       procedure :: init => corrector_init
       procedure :: reset_grid => corrector_reset_grid
       procedure :: prepare => corrector_prepare
+      procedure :: measure_excess => corrector_measure_excess
       procedure :: apply_shifts => corrector_apply_shifts
       procedure :: relax_pressure => corrector_relax_pressure
    end type volume_corrector_t
@@ -149,19 +152,16 @@ contains
       if (allocated(self%wall_activity)) deallocate (self%wall_activity)
    end subroutine corrector_reset_grid
 
-   !> At x^n, before the step's particle-to-grid transfer: the shifts of step `step` (every interval-th
-   !> step; by the step number, so a restart keeps the rhythm). Collective. `stencils` (3-D): the occupancy's
-   !> transfer keeps the particles' stencils there for the gradient's (src/transfer/stencil_cache.f90).
-   subroutine corrector_prepare(self, domain, grid, walls, particles, step, stencils)
+   !> At x^n, before the step's particle-to-grid transfer, on the steps that shift (every interval-th step; by
+   !> the step number, so a restart keeps the rhythm): the open volumes where the walls changed, the cells'
+   !> volumes equalised and the height function of the free surface. Collective.
+   subroutine corrector_prepare(self, domain, grid, walls, particles, step)
       class(volume_corrector_t), intent(inout) :: self
       type(domain_t), intent(in) :: domain
       type(grid_t), intent(in) :: grid
       type(wall_t), intent(in) :: walls(:)
       type(particle_set_t), intent(inout) :: particles
       integer(i8), intent(in) :: step
-      type(stencil_cache_t), intent(inout), optional :: stencils
-      integer :: i
-      real(rp) :: threshold
 
       self%shifting_now = self%shifting .and. mod(step, int(self%interval, i8)) == 0
       if (.not. self%shifting_now) return
@@ -170,12 +170,29 @@ contains
       else if (any(self%wall_activity .neqv. walls%active)) then
          call measure_open_volumes(self, grid, walls)
       end if
+      call equalize_cell_volumes(self, grid, particles)
+      if (self%surface_model) call measure_surface_heights(self, domain, grid, particles)
+   end subroutine corrector_prepare
+
+   !> After the step's particle-to-grid transfer, positions still x^n (the transfer does not read the
+   !> densities prepare equalised), on the steps that shift: the occupancy, psi_i and the particles' shifts.
+   !> Collective. `stencils` (3-D): the transfer's (src/transfer/stencil_cache.f90), which the occupancy and
+   !> the gradients read with the shortcuts instead of locating the particles again.
+   subroutine corrector_measure_excess(self, domain, grid, walls, particles, stencils)
+      class(volume_corrector_t), intent(inout) :: self
+      type(domain_t), intent(in) :: domain
+      type(grid_t), intent(in) :: grid
+      type(wall_t), intent(in) :: walls(:)
+      type(particle_set_t), intent(in) :: particles
+      type(stencil_cache_t), intent(in), optional :: stencils
+      integer :: i
+      real(rp) :: threshold
+
+      if (.not. self%shifting_now) return
       if (allocated(self%excess)) then
          if (size(self%excess, 2) /= grid%node_count) deallocate (self%excess)
       end if
       if (.not. allocated(self%excess)) allocate (self%excess(1, grid%node_count))
-
-      call equalize_cell_volumes(self, grid, particles)
       self%excess = 0.0_rp
       if (self%shortcuts .and. present(stencils)) then
          call volume_to_grid(grid, particles, self%excess(1, :), stencils)
@@ -184,10 +201,7 @@ contains
       end if
       call sum_shared_nodes(domain, grid, self%excess)
       self%fluid_volume = self%open_volume
-      if (self%surface_model) then
-         call measure_surface_heights(self, domain, grid, particles)
-         call cut_by_surface(self, grid, walls)
-      end if
+      if (self%surface_model) call cut_by_surface(self, grid, walls)
       threshold = min_open_fraction * grid%h**grid%dim
       do i = 1, grid%node_count
          if (self%fluid_volume(i) >= threshold) then
@@ -198,9 +212,12 @@ contains
       end do
       ! a node cut by the free surface to a sliver is empty (psi = 0: crowding below may push into it);
       ! one cut by walls to a sliver is unknown (the particle's own excess: walls neither sink nor source)
-      ! (the stencils hold the particles only if volume_to_grid kept them: else the gradient locates them)
-      call shifts_of_particles(self, grid, particles, self%open_volume >= threshold, stencils)
-   end subroutine corrector_prepare
+      if (self%shortcuts .and. present(stencils)) then
+         call shifts_of_particles(self, grid, particles, self%open_volume >= threshold, stencils)
+      else
+         call shifts_of_particles(self, grid, particles, self%open_volume >= threshold)
+      end if
+   end subroutine corrector_measure_excess
 
    !> dx_p = -D h^2 sum_a grad N_a psi_a for the particles of shifting materials, at most 0.1 h long.
    !> A node mostly closed by walls has no reliable occupancy: it takes the particle's own excess (the

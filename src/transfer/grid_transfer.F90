@@ -292,26 +292,24 @@ contains
       end do
    end subroutine node_offsets
 
-   !> o_i += sum_p N_ip m_p / rho_p over all particles (src/stabilization/volume_correction.f90). With
-   !> `stencils` (3-D): each particle's stencil is kept there for gradient_at_particles of the same step.
+   !> o_i += sum_p N_ip m_p / rho_p over all particles (src/stabilization/volume_correction.f90).
+   !> `stencils`: P2G's of this step (used when it holds this set's particles).
    subroutine volume_to_grid(grid, particles, occupancy, stencils)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(in) :: particles
       real(rp), intent(inout) :: occupancy(:)
-      type(stencil_cache_t), intent(inout), optional :: stencils
-      call start_keeping_stencils(grid, particles, stencils)
+      type(stencil_cache_t), intent(in), optional :: stencils
       select case (instance(grid))
       case (kernels_linear_2d); call volume_to_grid_2d(grid, particles, occupancy)
       case (kernels_linear_3d); call volume_to_grid_3d(grid, particles, occupancy, stencils)
       case (kernels_bspline2_2d); call volume_to_grid_b2_2d(grid, particles, occupancy)
       case default; call volume_to_grid_b2_3d(grid, particles, occupancy, stencils)
       end select
-      call stencils_kept(grid, particles, stencils)
    end subroutine volume_to_grid
 
    !> gradient(:, p) = sum_a grad N_a(x_p) field_a for p = first..last at x^n; a node that is not `known`
-   !> takes the N-weighted mean of the particle's known stencil nodes. `stencils`: volume_to_grid's of this
-   !> step (used when it holds this set's particles).
+   !> takes the N-weighted mean of the particle's known stencil nodes. `stencils`: P2G's of this step (used
+   !> when it holds this set's particles).
    subroutine gradient_at_particles(grid, particles, first, last, field, known, gradient, stencils)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(in) :: particles

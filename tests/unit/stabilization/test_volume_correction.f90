@@ -11,9 +11,9 @@
 !>    the correction; 2-D and 3-D;
 !>  - the sub-cell fraction under a surface plane is exact (box cut by a plane: known areas and volumes);
 !>  - the corrector's shortcuts (height lookups and minima per column, rows above the surface skipped, walls
-!>    far from a node left out, cube roots per run, kept stencils) give the general way's open volumes,
-!>    fluid volumes and shifts, bit for bit, under a free surface that is not flat and beside an inclined
-!>    wall (2-D and 3-D); the stencils kept by the occupancy's transfer give the gradient of located ones;
+!>    far from a node left out, cube roots per run, P2G's stencils read) give the general way's open
+!>    volumes, fluid volumes and shifts, bit for bit, under a free surface that is not flat and beside an
+!>    inclined wall (2-D and 3-D); P2G's kept stencils give the gradient of located ones;
 !>  - eos_relaxation starts a hydrostatic fluid in its EOS state p = K ln(rho/rho_0) and, at rate 1,
 !>    puts every particle's pressure back on it after each step.
 module test_volume_correction
@@ -29,7 +29,7 @@ module test_volume_correction
    use run_diagnostics, only: diagnostics_t
    use test_scenes, only: water_scene, add_body
    use input_text, only: real_text
-   use grid_transfer, only: gradient_at_particles
+   use grid_transfer, only: gradient_at_particles, particles_to_grid
    use stencil_cache, only: holds_stencils
    use reproducible_numbers, only: hash01
    implicit none
@@ -128,7 +128,7 @@ contains
    !> inclined wall beyond the layer (a beach: it cuts supports at angles to the grid), run a few steps by two
    !> identical solvers; then one application each, with the corrector's shortcuts and the general way
    !> (volume_corrector_t%shortcuts): the same open volumes, fluid volumes and shifts, bit for bit, and
-   !> shifts not zero; and with the stencils the first kept, the gradient of a field varying along every
+   !> shifts not zero; and with the stencils its transfer kept, the gradient of a field varying along every
    !> axis is that with the stencils located again.
    subroutine test_shortcuts_are_the_general_way(comm)
       type(MPI_Comm), intent(in) :: comm
@@ -172,7 +172,10 @@ contains
       do i = 1, 2
          associate (s => solver(i))
             call s%volume%reset_grid()       ! the open volumes measured again, each way
-            call s%volume%prepare(s%domain, s%grid, s%walls, s%particles, int(s%volume%interval, i8), s%stencils)
+            ! an application as the step makes it: prepare, the transfer (its stencils kept in 3-D), the rest
+            call s%volume%prepare(s%domain, s%grid, s%walls, s%particles, int(s%volume%interval, i8))
+            call particles_to_grid(s%grid, s%particles, s%gravity, stencils=s%stencils)
+            call s%volume%measure_excess(s%domain, s%grid, s%walls, s%particles, s%stencils)
          end associate
       end do
       call assertTrue(solver(1)%volume%shifting_now .and. solver(1)%volume%surface_model, label//': an application')
@@ -187,8 +190,9 @@ contains
       difference(3) = maxval(abs(solver(1)%volume%fluid_volume - solver(2)%volume%fluid_volume))
       cut_supports = count(.not. solver(1)%volume%fully_open)
       call MPI_Allreduce(MPI_IN_PLACE, cut_supports, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
-      ! the stencils kept by the occupancy's transfer (3-D) against located ones, for a nodal field that
-      ! varies along every axis (the excess of this scene hardly varies across its layers)
+      ! the stencils kept by the transfer (3-D), which the occupancy and the gradients read, against located
+      ! ones, for a nodal field that varies along every axis (the excess of this scene hardly varies across
+      ! its layers)
       call assertTrue(holds_stencils(solver(1)%stencils, n) .eqv. dim == 3, label//': stencils kept in 3-D only')
       associate (grid => solver(1)%grid)
          allocate (field(grid%node_count), known(grid%node_count), kept(dim, n), located(dim, n))
