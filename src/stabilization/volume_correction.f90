@@ -184,21 +184,20 @@ contains
       type(grid_t), intent(in) :: grid
       type(wall_t), intent(in) :: walls(:)
       type(particle_set_t), intent(in) :: particles
-      type(stencil_cache_t), intent(in), optional :: stencils
+      type(stencil_cache_t), intent(in), optional, target :: stencils
+      type(stencil_cache_t), pointer :: kept     ! the stencils read; disassociated (absent) the general way
       integer :: i
       real(rp) :: threshold
 
       if (.not. self%shifting_now) return
+      kept => null()
+      if (self%shortcuts .and. present(stencils)) kept => stencils
       if (allocated(self%excess)) then
          if (size(self%excess, 2) /= grid%node_count) deallocate (self%excess)
       end if
       if (.not. allocated(self%excess)) allocate (self%excess(1, grid%node_count))
       self%excess = 0.0_rp
-      if (self%shortcuts .and. present(stencils)) then
-         call volume_to_grid(grid, particles, self%excess(1, :), stencils)
-      else
-         call volume_to_grid(grid, particles, self%excess(1, :))
-      end if
+      call volume_to_grid(grid, particles, self%excess(1, :), kept)
       call sum_shared_nodes(domain, grid, self%excess)
       self%fluid_volume = self%open_volume
       if (self%surface_model) call cut_by_surface(self, grid, walls)
@@ -212,11 +211,7 @@ contains
       end do
       ! a node cut by the free surface to a sliver is empty (psi = 0: crowding below may push into it);
       ! one cut by walls to a sliver is unknown (the particle's own excess: walls neither sink nor source)
-      if (self%shortcuts .and. present(stencils)) then
-         call shifts_of_particles(self, grid, particles, self%open_volume >= threshold, stencils)
-      else
-         call shifts_of_particles(self, grid, particles, self%open_volume >= threshold)
-      end if
+      call shifts_of_particles(self, grid, particles, self%open_volume >= threshold, kept)
    end subroutine corrector_measure_excess
 
    !> dx_p = -D h^2 sum_a grad N_a psi_a for the particles of shifting materials, at most 0.1 h long.
