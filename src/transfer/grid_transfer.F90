@@ -53,7 +53,11 @@ contains
       integer, intent(in), optional :: field(:), field_row
       type(stencil_cache_t), intent(inout), optional :: stencils
       grid%accumulated = 0.0_rp
-      call start_keeping_stencils(grid, particles, stencils)
+      if (present(stencils)) then
+         call forget_stencils(stencils)
+         ! only the 3-D kernels keep stencils: the 2-D ones locate a block of particles at a time, vectorised
+         if (grid%dim == 3) call size_stencil_cache(stencils, size(particles%mass))
+      end if
       if (present(field)) then
          select case (transfer_instance(grid, particles))
          case (kernels_linear_2d); call particles_to_grid_fields_2d(grid, particles, gravity, field, field_row)
@@ -80,29 +84,10 @@ contains
          case default; call particles_to_grid_apic_b2_3d(grid, particles, gravity, stencils)
          end select
       end if
-      call stencils_kept(grid, particles, stencils)
+      if (present(stencils)) then
+         if (grid%dim == 3) stencils%count = particles%count
+      end if
    end subroutine particles_to_grid
-
-   !> Before a pass that keeps the particles' stencils in `stencils` (if given): it holds none, and has room
-   !> for every particle. Only the 3-D kernels keep stencils: the 2-D ones locate a block of particles at a
-   !> time, vectorised.
-   subroutine start_keeping_stencils(grid, particles, stencils)
-      type(grid_t), intent(in) :: grid
-      type(particle_set_t), intent(in) :: particles
-      type(stencil_cache_t), intent(inout), optional :: stencils
-      if (.not. present(stencils)) return
-      call forget_stencils(stencils)
-      if (grid%dim == 3) call size_stencil_cache(stencils, size(particles%mass))
-   end subroutine start_keeping_stencils
-
-   !> After that pass: `stencils` (if given) holds the stencils of the particles (3-D).
-   subroutine stencils_kept(grid, particles, stencils)
-      type(grid_t), intent(in) :: grid
-      type(particle_set_t), intent(in) :: particles
-      type(stencil_cache_t), intent(inout), optional :: stencils
-      if (.not. present(stencils)) return
-      if (grid%dim == 3) stencils%count = particles%count
-   end subroutine stencils_kept
 
    !> MUSL, first half of step 7 fused with the re-map: v_p := alpha (v_p + sum N dv_i) + (1 - alpha) sum N
    !> v_i^{n+1}, then momentum(:, i) = sum N m_p v_p with the updated velocities (both at x^n).

@@ -5,10 +5,9 @@
 !> "Stencils located once per step"). Only the 3-D kernels keep them (28 bytes per particle).
 !>
 !> Valid while the particles neither move nor change order: the solver gives it to P2G, which fills it, and
-!> to the passes up to G2P, and forgets it once G2P has moved the particles. On the steps that apply the
-!> volume correction, its occupancy transfer fills it first (at the same x^n) for its gradient pass; P2G then
-!> fills it again. A reader takes it only when it holds as many particles as the set it visits
-!> (holds_stencils); else it locates them itself.
+!> to the passes up to G2P, and forgets it once G2P has moved the particles (the volume correction's
+!> occupancy and gradient transfers, between P2G and G2P, read it too). A reader takes it only when it holds
+!> as many particles as the set it visits (holds_stencils); else it locates them itself.
 module stencil_cache
    use kinds, only: rp
    implicit none

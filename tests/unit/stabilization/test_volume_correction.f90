@@ -240,16 +240,16 @@ contains
          real(rp), intent(in) :: x(:), field(:)
          logical, intent(in) :: known(:)
          real(rp) :: gradient(size(x)), xi(size(x)), f(2**size(x)), n(2**size(x)), weight, mean
-         integer :: cell(size(x)), corner(size(x)), a, k, j, node(2**size(x))
+         integer :: cell(size(x)), corner(size(x), 2**size(x)), a, k, j, node(2**size(x))
          xi = (x - grid%origin(1:size(x))) * grid%inv_h
          cell = floor(xi)
          xi = xi - cell
          weight = 0.0_rp
          mean = 0.0_rp
          do a = 1, 2**size(x)
-            corner = [(ibits(a - 1, k - 1, 1), k = 1, size(x))]
-            node(a) = grid%local_node(cell + corner)
-            n(a) = product(merge(xi, 1.0_rp - xi, corner == 1))
+            corner(:, a) = [(ibits(a - 1, k - 1, 1), k = 1, size(x))]
+            node(a) = grid%local_node(cell + corner(:, a))
+            n(a) = product(merge(xi, 1.0_rp - xi, corner(:, a) == 1))
             f(a) = field(node(a))
             if (known(node(a))) then
                weight = weight + n(a)
@@ -260,11 +260,10 @@ contains
          where (.not. known(node)) f = mean
          gradient = 0.0_rp
          do a = 1, 2**size(x)
-            corner = [(ibits(a - 1, k - 1, 1), k = 1, size(x))]
             do k = 1, size(x)
                ! d N_a / d x_k: the other axes' factors times +-1/h along k
-               gradient(k) = gradient(k) + f(a) * merge(1.0_rp, -1.0_rp, corner(k) == 1) * grid%inv_h * &
-                             product(merge(xi, 1.0_rp - xi, corner == 1), mask=[(j /= k, j = 1, size(x))])
+               gradient(k) = gradient(k) + f(a) * merge(1.0_rp, -1.0_rp, corner(k, a) == 1) * grid%inv_h * &
+                             product(merge(xi, 1.0_rp - xi, corner(:, a) == 1), mask=[(j /= k, j = 1, size(x))])
             end do
          end do
       end function multilinear_gradient
