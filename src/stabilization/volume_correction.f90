@@ -91,7 +91,7 @@ module volume_correction
       real(rp), allocatable :: fluid_volume(:)      !< V_i cut by the free surface [m^dim]
       type(cell_list_t) :: occupied                 !< the cells holding one shifting material's particles
       real(rp), allocatable :: cell_mass(:)         !< per cell: that material's mass
-      real(rp), allocatable :: cell_average(:, :)   !< per cell: its mean specific volume (work)
+      real(rp), allocatable :: cell_average(:, :)   !< per cell: its mean specific volume, then its inverse (work)
       real(rp), allocatable :: specific_volume(:, :) !< (1, p): 1 / rho_p of a material's slice (work, kept)
       logical :: surface_model = .false.            !< under gravity: V_i knows where the free surface is
       real(rp) :: up(3) = 0.0_rp                    !< against gravity, unit (grid frame)
@@ -364,7 +364,7 @@ contains
       type(volume_corrector_t), intent(inout) :: self
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(inout) :: particles
-      integer :: m, first, last, n, p
+      integer :: m, first, last, n, p, i, c
       if (allocated(self%cell_mass)) then
          if (size(self%cell_mass) /= grid%cell_count) deallocate (self%cell_mass, self%cell_average)
       end if
@@ -387,8 +387,13 @@ contains
             call bin_cell_mass_and_mean(particles, first, last, specific_volume, self%occupied, self%cell_mass, &
                                         self%cell_average)
          end associate
+         ! 1 / mean once per cell, then a plain gather
+         do i = 1, self%occupied%count
+            c = self%occupied%cells(i)
+            self%cell_average(1, c) = 1.0_rp / self%cell_average(1, c)
+         end do
          do p = first, last
-            particles%density(p) = 1.0_rp / self%cell_average(1, particles%cell(p))
+            particles%density(p) = self%cell_average(1, particles%cell(p))
          end do
       end do
    end subroutine equalize_cell_volumes
@@ -432,12 +437,16 @@ contains
       self%surface_height = no_surface
 
       ! per block: the tops and bin ranges in a loop without stores to the bins (it vectorises in 2-D:
-      ! sqrt and the divisions 8 particles at a time), then the maxima bin by bin
+      ! sqrt and the divisions 8 particles at a time), then the maxima bin by bin. The blocks and their
+      ! particles from the last to the first: sorted by cell, with the cells' last axis slowest, they come
+      ! top down, so a bin is rarely raised after its first particles and the store is mostly skipped (a
+      ! store per bin made every update wait for the one before: a store-to-load chain). The maximum does
+      ! not depend on the order.
       third = 1.0_rp / 3.0_rp
       width_mass = -1.0_rp      ! no particle's: the first 3-D particle takes its cube root
       width_density = -1.0_rp
       width = 0.0_rp
-      do b = 1, particles%count, block_size
+      do b = 1 + ((particles%count - 1) / block_size) * block_size, 1, -block_size
          e = min(particles%count, b + block_size - 1)
          if (dim == 2) then
             do p = b, e
@@ -466,10 +475,10 @@ contains
                                    last(:, p - b + 1))
             end do
          end if
-         do p = 1, e - b + 1
+         do p = e - b + 1, 1, -1
             do j = first(2, p), last(2, p)
                do i = first(1, p), last(1, p)
-                  self%surface_height(i, j) = max(self%surface_height(i, j), top(p))
+                  if (top(p) > self%surface_height(i, j)) self%surface_height(i, j) = top(p)
                end do
             end do
          end do

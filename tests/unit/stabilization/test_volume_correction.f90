@@ -29,7 +29,7 @@ module test_volume_correction
    use run_diagnostics, only: diagnostics_t
    use test_scenes, only: water_scene, add_body
    use input_text, only: real_text
-   use grid_transfer, only: gradient_at_particles, particles_to_grid
+   use grid_transfer, only: gradient_at_particles, particles_to_grid, volume_to_grid
    use background_grid, only: grid_t
    use stencil_cache, only: holds_stencils
    use reproducible_numbers, only: hash01
@@ -143,8 +143,8 @@ contains
       type(solver_t), target :: solver(2)
       type(scene_t) :: scene
       type(status_t) :: status
-      real(rp) :: largest, difference(5), cut_supports, steepest, reference(dim)
-      real(rp), allocatable :: field(:), kept(:, :), located(:, :)
+      real(rp) :: largest, difference(6), cut_supports, steepest, reference(dim), fullest
+      real(rp), allocatable :: field(:), kept(:, :), located(:, :), occupancy(:), summed(:)
       logical, allocatable :: known(:)
       integer :: i, step, n, node
       character(len=2) :: label
@@ -214,11 +214,28 @@ contains
       end associate
       difference(4) = 0.0_rp
       if (n > 0) difference(4) = maxval(abs(kept - located))
+      ! the occupancy's transfer (its sums kept along runs of particles with one stencil) against the
+      ! multilinear functions' formula summed particle by particle, on this rank's nodes
+      associate (grid => solver(1)%grid, particles => solver(1)%particles)
+         allocate (occupancy(grid%node_count), summed(grid%node_count))
+         occupancy = 0.0_rp
+         call volume_to_grid(grid, particles, occupancy, solver(1)%stencils)
+         summed = 0.0_rp
+         do i = 1, n
+            call add_multilinear_volume(grid, particles%x(1:dim, i), particles%mass(i) / particles%density(i), summed)
+         end do
+         fullest = maxval(summed)
+         difference(6) = maxval(abs(occupancy - summed))
+      end associate
       call MPI_Allreduce(MPI_IN_PLACE, largest, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
       call MPI_Allreduce(MPI_IN_PLACE, steepest, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
-      call MPI_Allreduce(MPI_IN_PLACE, difference, 5, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+      call MPI_Allreduce(MPI_IN_PLACE, fullest, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+      call MPI_Allreduce(MPI_IN_PLACE, difference, 6, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
       call assertTrue(difference(5) <= 1.0e-12_rp * steepest, label//': the gradients are the formula''s to '// &
                       'round-off, largest difference '//real_text(difference(5))//' of '//real_text(steepest))
+      call assertTrue(fullest > 0.0_rp .and. difference(6) <= 1.0e-12_rp * fullest, label//': the occupancy is '// &
+                      'the formula''s to round-off, largest difference '//real_text(difference(6))//' of '// &
+                      real_text(fullest))
       call assertTrue(largest > 0.0_rp, label//': particles shift')
       call assertTrue(cut_supports > 0.0_rp, label//': walls cut some supports')
       call assertTrue(difference(1) <= 0.0_rp, label//': the same shifts bit for bit, largest difference '// &
@@ -267,6 +284,23 @@ contains
             end do
          end do
       end function multilinear_gradient
+
+      !> summed(i) += N_i(x) volume over the 2^dim nodes of x's cell (multilinear hat functions).
+      subroutine add_multilinear_volume(grid, x, volume, summed)
+         type(grid_t), intent(in) :: grid
+         real(rp), intent(in) :: x(:), volume
+         real(rp), intent(inout) :: summed(:)
+         real(rp) :: xi(size(x))
+         integer :: cell(size(x)), corner(size(x)), a, k, node
+         xi = (x - grid%origin(1:size(x))) * grid%inv_h
+         cell = floor(xi)
+         xi = xi - cell
+         do a = 1, 2**size(x)
+            corner = [(ibits(a - 1, k - 1, 1), k = 1, size(x))]
+            node = grid%local_node(cell + corner)
+            summed(node) = summed(node) + product(merge(xi, 1.0_rp - xi, corner == 1)) * volume
+         end do
+      end subroutine add_multilinear_volume
 
       !> An unbounded slip wall through `point` with inward normal `normal` (world frame).
       type(wall_spec_t) function beach(point, normal)
