@@ -103,9 +103,10 @@ module volume_correction
       real(rp), allocatable :: shift(:, :)          !< (dim, p): displacement added after the position update
       !> shortcuts that give the same bits (a test compares them with the general way): where up is a grid axis
       !> the surface cut looks the height up once per column of sub-cells, takes the lowest height once per
-      !> column of nodes and stops at the first row of sub-cells above the surface; the walls far from a
-      !> node are not tested at its samples; a cube root per run of particles of one mass and density; the
-      !> occupancy's and the gradients' transfers read P2G's stencils (3-D). Off: the general way throughout
+      !> column of nodes and stops at the first row of sub-cells above the surface; the height function skips
+      !> the blocks of particles that raise no bin; the walls far from a node are not tested at its samples; a
+      !> cube root per run of particles of one mass and density; the occupancy's and the gradients' transfers
+      !> read P2G's stencils (3-D). Off: the general way throughout
       logical :: shortcuts = .true.
    contains
       procedure :: init => corrector_init
@@ -407,9 +408,9 @@ contains
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(in) :: particles
       integer, parameter :: block_size = 256
-      integer :: dim, k, p, corner, n(2), first(2, block_size), last(2, block_size), i, j, b, e
+      integer :: dim, k, p, corner, n(2), first(2, block_size), last(2, block_size), i, j, b, e, covered(2, 2)
       real(rp) :: box_hi(3), x(3), u, lo(2), hi(2), top(block_size), third, width, width_mass, width_density, &
-                  widths(block_size)
+                  widths(block_size), block_top, lowest
 
       dim = grid%dim
       self%bin_width = grid%h / bins_per_cell(dim)
@@ -474,6 +475,27 @@ contains
                call particle_reach(3, widths(p - b + 1), particles%x(1:3, p), top(p - b + 1), first(:, p - b + 1), &
                                    last(:, p - b + 1))
             end do
+         end if
+         if (self%shortcuts) then
+            ! a block whose highest top is no higher than every bin its particles' bins span would raise none:
+            ! skipped (coming top down, every block below the surface layer is)
+            covered(:, 1) = n + 1
+            covered(:, 2) = 0
+            block_top = -huge(1.0_rp)
+            do p = 1, e - b + 1
+               covered(:, 1) = min(covered(:, 1), first(:, p))
+               covered(:, 2) = max(covered(:, 2), last(:, p))
+               block_top = max(block_top, top(p))
+            end do
+            ! the lowest bin by min, not minval (whose NaN rules make it a scalar loop): no height is NaN, a
+            ! NaN top never raises a bin
+            lowest = huge(1.0_rp)
+            do j = covered(2, 1), covered(2, 2)
+               do i = covered(1, 1), covered(1, 2)
+                  lowest = min(lowest, self%surface_height(i, j))
+               end do
+            end do
+            if (block_top <= lowest) cycle
          end if
          do p = e - b + 1, 1, -1
             do j = first(2, p), last(2, p)
@@ -588,55 +610,79 @@ contains
                end if
                call support_samples(grid, x_node, surface_samples_per_cell(dim), sample_x, axis_weight)
                if (.not. self%fully_open(node)) near = walls_near(self, grid, walls, counts, x_node)
+               volume = 0.0_rp
                if (upright) then
                   call column_heights(column_height)
-                  highest = maxval(column_height(1:per_axis**(dim - 1)))
-               end if
-               volume = 0.0_rp
-               s = 1
-               do
-                  ! upright: the samples go up row by row; a row whose bottom is above the highest column
-                  ! (rounding is monotone, so no sample of it passes the test below) and those after it add
-                  ! nothing
-                  if (upright .and. all(s(1:dim - 1) == 1)) then
-                     if (highest - sample_x(s(dim), dim) <= -half_depth) exit
-                  end if
-                  weight = sub_volume
-                  do k = 1, dim
-                     x(k) = sample_x(s(k), k)
-                     weight = weight * axis_weight(s(k), k)
-                  end do
-                  if (upright) then
-                     column = s(1)
-                     if (dim == 3) column = column + per_axis * (s(2) - 1)
-                     surface = column_height(column) - x(dim)
-                  else
+                  call add_upright_samples()
+               else
+                  s = 1
+                  do
+                     weight = sub_volume
+                     do k = 1, dim
+                        x(k) = sample_x(s(k), k)
+                        weight = weight * axis_weight(s(k), k)
+                     end do
                      surface = surface_over(self, x, dim) - dot_product(x(1:dim), self%up(1:dim))
-                  end if
-                  if (surface > -half_depth) then     ! not wholly above the surface (no_surface is)
-                     share = 1.0_rp
-                     if (surface < half_depth) call part_below(surface, extent(1:dim), share, rise_of_part)
-                     if (share < 1.0_rp) then
-                        ! N_i at the part's height (exact for a cut along a grid axis; N is linear there)
-                        weight = sub_volume
-                        do k = 1, dim
-                           weight = weight * (1.0_rp - abs(x(k) + rise_of_part * self%up(k) - x_node(k)) * grid%inv_h)
-                        end do
-                     end if
-                     weight = weight * share
-                     if (weight > 0.0_rp) then
-                        if (.not. self%fully_open(node)) weight = weight * open_fraction(grid, walls, near, x)
-                        volume = volume + weight
-                     end if
-                  end if
-                  if (.not. next_sample(s, dim, per_axis)) exit
-               end do
+                     call add_sample()
+                     if (.not. next_sample(s, dim, per_axis)) exit
+                  end do
+               end if
                self%fluid_volume(node) = min(volume, self%open_volume(node))
             end do
          end do
       end do
 
    contains
+
+      !> volume += the sample at x (weight: its N_i times sub_volume) if it is not wholly above the surface,
+      !> `surface` above it (no_surface is), counted with its part below the surface and the open fraction.
+      subroutine add_sample()
+         if (.not. (surface > -half_depth)) return
+         share = 1.0_rp
+         if (surface < half_depth) call part_below(surface, extent(1:dim), share, rise_of_part)
+         if (share < 1.0_rp) then
+            ! N_i at the part's height (exact for a cut along a grid axis; N is linear there)
+            weight = sub_volume
+            do k = 1, dim
+               weight = weight * (1.0_rp - abs(x(k) + rise_of_part * self%up(k) - x_node(k)) * grid%inv_h)
+            end do
+         end if
+         weight = weight * share
+         if (weight > 0.0_rp) then
+            if (.not. self%fully_open(node)) weight = weight * open_fraction(grid, walls, near, x)
+            volume = volume + weight
+         end if
+      end subroutine add_sample
+
+      !> The samples of the upright support in the general way's order (the first axis fastest, rows going
+      !> up), each column of sub-cells with its own height: a sample wholly above its column's surface adds
+      !> nothing, so it is skipped before its weight is formed, and a row whose bottom is above the highest
+      !> column (rounding is monotone) ends the support. The same additions in the same order.
+      subroutine add_upright_samples()
+         integer :: row, c1, c2, columns_2
+         columns_2 = merge(per_axis, 1, dim == 3)
+         highest = maxval(column_height(1:per_axis**(dim - 1)))
+         do row = 1, per_axis
+            x(dim) = sample_x(row, dim)
+            if (highest - x(dim) <= -half_depth) exit
+            column = 0
+            do c2 = 1, columns_2
+               do c1 = 1, per_axis
+                  column = column + 1
+                  surface = column_height(column) - x(dim)
+                  if (.not. (surface > -half_depth)) cycle
+                  x(1) = sample_x(c1, 1)
+                  weight = sub_volume * axis_weight(c1, 1)
+                  if (dim == 3) then
+                     x(2) = sample_x(c2, 2)
+                     weight = weight * axis_weight(c2, 2)
+                  end if
+                  weight = weight * axis_weight(row, dim)
+                  call add_sample()
+               end do
+            end do
+         end do
+      end subroutine add_upright_samples
 
       !> The lowest height function over the bins the support of the node at x_node spans horizontally
       !> (no_surface if a bin has no particle over it).

@@ -39,7 +39,7 @@ module test_volume_correction
    public :: test_shifting_leaves_a_filled_tank_alone, test_shifting_spreads_crowded_particles, &
              test_eos_relaxation_keeps_the_eos_state, test_shift_takes_the_hydrostatic_pressure, &
              test_shifting_lifts_a_crowded_surface_layer, test_fraction_below_a_plane, &
-             test_shortcuts_are_the_general_way
+             test_shortcuts_are_the_general_way, test_height_function_skips_exactly
 
 contains
 
@@ -143,7 +143,7 @@ contains
       type(solver_t), target :: solver(2)
       type(scene_t) :: scene
       type(status_t) :: status
-      real(rp) :: largest, difference(6), cut_supports, steepest, reference(dim), fullest
+      real(rp) :: largest, difference(7), cut_supports, steepest, reference(dim), fullest
       real(rp), allocatable :: field(:), kept(:, :), located(:, :), occupancy(:), summed(:)
       logical, allocatable :: known(:)
       integer :: i, step, n, node
@@ -151,8 +151,10 @@ contains
       label = merge('2D', '3D', dim == 2)
       if (dim == 2) then
          scene = water_scene(2, 0.1_rp, [2.0_rp, 1.2_rp, 0.0_rp], 2.0e6_rp, 10.0_rp)
-         call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [0.6_rp, 0.8_rp, 0.0_rp], 2, .true., 0.8_rp)
-         call add_body(scene, 1, [0.6_rp, 0.0_rp, 0.0_rp], [1.4_rp, 0.25_rp, 0.0_rp], 2, .true., 0.25_rp)
+         ! 4 x 4 particles per cell: the surface heights' blocks of 256 particles below the top rows raise no
+         ! bin, which the shortcuts skip
+         call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [0.6_rp, 0.8_rp, 0.0_rp], 4, .true., 0.8_rp)
+         call add_body(scene, 1, [0.6_rp, 0.0_rp, 0.0_rp], [1.4_rp, 0.25_rp, 0.0_rp], 4, .true., 0.25_rp)
          scene%walls = [beach([1.53_rp, 0.0_rp, 0.0_rp], [-1.0_rp, 0.7_rp, 0.0_rp])]
       else
          scene = water_scene(3, 0.1_rp, [1.2_rp, 0.4_rp, 0.8_rp], 2.0e6_rp, 10.0_rp)
@@ -189,6 +191,7 @@ contains
       end if
       difference(2) = maxval(abs(solver(1)%volume%open_volume - solver(2)%volume%open_volume))
       difference(3) = maxval(abs(solver(1)%volume%fluid_volume - solver(2)%volume%fluid_volume))
+      difference(7) = maxval(abs(solver(1)%volume%surface_height - solver(2)%volume%surface_height))
       cut_supports = count(.not. solver(1)%volume%fully_open)
       call MPI_Allreduce(MPI_IN_PLACE, cut_supports, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
       ! the stencils kept by the transfer (3-D), which the occupancy and the gradients read, against located
@@ -230,7 +233,7 @@ contains
       call MPI_Allreduce(MPI_IN_PLACE, largest, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
       call MPI_Allreduce(MPI_IN_PLACE, steepest, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
       call MPI_Allreduce(MPI_IN_PLACE, fullest, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
-      call MPI_Allreduce(MPI_IN_PLACE, difference, 6, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+      call MPI_Allreduce(MPI_IN_PLACE, difference, 7, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
       call assertTrue(difference(5) <= 1.0e-12_rp * steepest, label//': the gradients are the formula''s to '// &
                       'round-off, largest difference '//real_text(difference(5))//' of '//real_text(steepest))
       call assertTrue(fullest > 0.0_rp .and. difference(6) <= 1.0e-12_rp * fullest, label//': the occupancy is '// &
@@ -244,6 +247,8 @@ contains
                       real_text(difference(2))//' m^dim')
       call assertTrue(difference(3) <= 0.0_rp, label//': the same fluid volumes bit for bit, largest difference '// &
                       real_text(difference(3))//' m^dim')
+      call assertTrue(difference(7) <= 0.0_rp, label//': the same surface heights bit for bit, largest difference '// &
+                      real_text(difference(7))//' m')
       call assertTrue(difference(4) <= 0.0_rp, label//': kept stencils give the located gradient bit for bit, '// &
                       'largest difference '//real_text(difference(4)))
       do i = 1, 2
@@ -311,6 +316,56 @@ contains
          beach%name = 'beach'
       end function beach
    end subroutine compare_shortcuts
+
+   !> The height function's shortcut skips a block of particles none of which rises above the bins the block
+   !> spans. A wide flat layer (4 x 4 particles per cell, 480 per row of cells: blocks of 256 within a row or
+   !> two), with a few particles of its top row swapped into the bottom rows: their bins then stand a row
+   !> lower until the block that holds them, which must not be skipped. Against the general way, bit for bit,
+   !> and against the layer's top.
+   subroutine test_height_function_skips_exactly(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(solver_t) :: solver(2)
+      type(scene_t) :: scene
+      type(status_t) :: status
+      integer, allocatable :: dest(:)
+      integer :: i, n
+      real(rp) :: difference, error
+      scene = water_scene(2, 0.1_rp, [3.0_rp, 1.0_rp, 0.0_rp], 2.0e6_rp, 10.0_rp)
+      call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [3.0_rp, 0.4_rp, 0.0_rp], 4, .true., 0.4_rp)
+      scene%materials(1)%stabilization = 'FOAL1'
+      scene%materials(1)%volume_correction = 'shifting'
+      do i = 1, 2
+         call solver(i)%init(scene, comm, status)
+         call assertTrue(status%ok, trim(status%message))
+         call solver(i)%advance()             ! sorted by cell: the rows of cells bottom up
+      end do
+      solver(2)%volume%shortcuts = .false.
+      n = solver(1)%particles%count
+      allocate (dest(n))
+      dest = [(i, i = 1, n)]
+      do i = 37, n / 2, 100
+         dest(i) = n + 1 - i
+         dest(n + 1 - i) = i
+      end do
+      do i = 1, 2
+         call solver(i)%particles%permute(dest)
+         associate (s => solver(i))
+            call s%volume%prepare(s%domain, s%grid, s%walls, s%particles, int(s%volume%interval, i8))
+         end associate
+      end do
+      associate (height => solver(1)%volume%surface_height)
+         difference = maxval(abs(height - solver(2)%volume%surface_height))
+         ! the bins over the layer (3.0 m of the grid's 3.0 m: all of them) at its top, 0.4 m
+         error = maxval(abs(height - 0.4_rp))
+      end associate
+      call MPI_Allreduce(MPI_IN_PLACE, difference, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
+      call assertTrue(difference <= 0.0_rp, 'the same heights with the shortcut, largest difference '// &
+                      real_text(difference)//' m')
+      call assertTrue(error <= 1.0e-6_rp, 'the heights are the layer''s top, 0.4 m, to '//real_text(error)//' m')
+      do i = 1, 2
+         call solver(i)%free()
+      end do
+   end subroutine test_height_function_skips_exactly
 
    subroutine test_shifting_spreads_crowded_particles(comm)
       type(MPI_Comm), intent(in) :: comm
