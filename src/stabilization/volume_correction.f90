@@ -634,8 +634,9 @@ contains
 
    contains
 
-      !> volume += the sample at x (weight: its N_i times sub_volume) if it is not wholly above the surface,
-      !> `surface` above it (no_surface is), counted with its part below the surface and the open fraction.
+      !> volume += the sample at x (the host's x, `weight` = its N_i times sub_volume, `surface` = the surface's
+      !> height above it), with its part below the surface and its open fraction; nothing if it lies wholly
+      !> above the surface (as under no_surface).
       subroutine add_sample()
          if (.not. (surface > -half_depth)) return
          share = 1.0_rp
