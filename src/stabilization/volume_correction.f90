@@ -580,11 +580,12 @@ contains
       x = 0.0_rp
       first = 1
       last = 1
+      node = 0      ! the local flat index: the first axis fastest, as the loops go
       do l = grid%node_lo(3), grid%node_hi(3)
          do j = grid%node_lo(2), grid%node_hi(2)
             do i = grid%node_lo(1), grid%node_hi(1)
+               node = node + 1
                g = [i, j, l]
-               node = grid%local_node(g(1:dim))
                ! no particle in the support: phi = 0 whatever V_i is
                if (self%open_volume(node) <= 0.0_rp .or. self%excess(1, node) <= 0.0_rp) cycle
                x_node(1:dim) = grid%origin(1:dim) + g(1:dim) * grid%h
