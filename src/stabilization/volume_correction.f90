@@ -410,7 +410,7 @@ contains
       integer, parameter :: block_size = 256
       integer :: dim, k, p, corner, n(2), first(2, block_size), last(2, block_size), i, j, b, e, covered(2, 2)
       real(rp) :: box_hi(3), x(3), u, lo(2), hi(2), top(block_size), third, width, width_mass, width_density, &
-                  widths(block_size), block_top, lowest
+                  widths(block_size), block_top
 
       dim = grid%dim
       self%bin_width = grid%h / bins_per_cell(dim)
@@ -487,15 +487,8 @@ contains
                covered(:, 2) = max(covered(:, 2), last(:, p))
                block_top = max(block_top, top(p))
             end do
-            ! the lowest bin by min, not minval (whose NaN rules make it a scalar loop): no height is NaN, a
-            ! NaN top never raises a bin
-            lowest = huge(1.0_rp)
-            do j = covered(2, 1), covered(2, 2)
-               do i = covered(1, 1), covered(1, 2)
-                  lowest = min(lowest, self%surface_height(i, j))
-               end do
-            end do
-            if (block_top <= lowest) cycle
+            ! (a NaN top never raises a bin)
+            if (block_top <= lowest_height(self%surface_height, covered(:, 1), covered(:, 2))) cycle
          end if
          do p = e - b + 1, 1, -1
             do j = first(2, p), last(2, p)
@@ -694,7 +687,7 @@ contains
             first(k) = max(1, 1 + floor((u - reach(k)) / self%bin_width))
             last(k) = min(nb(k), 1 + floor((u + reach(k)) / self%bin_width))
          end do
-         lowest = minval(self%surface_height(first(1):last(1), first(2):last(2)))
+         lowest = lowest_height(self%surface_height, first, last)
       end function lowest_over_support
 
       !> The height function over each column of sub-cells of the support of the node at x_node (columns
@@ -716,6 +709,21 @@ contains
          end do
       end subroutine column_heights
    end subroutine cut_by_surface
+
+   !> The lowest height function over the bins first:last (per horizontal axis), huge if there are none: as
+   !> minval, by a loop of min (minval's rules for NaN make gfortran emit a scalar loop with branches; no height
+   !> is NaN).
+   pure real(rp) function lowest_height(height, first, last) result(lowest)
+      real(rp), intent(in) :: height(:, :)
+      integer, intent(in) :: first(2), last(2)
+      integer :: i, j
+      lowest = huge(1.0_rp)
+      do j = first(2), last(2)
+         do i = first(1), last(1)
+            lowest = min(lowest, height(i, j))
+         end do
+      end do
+   end function lowest_height
 
    !> True if up is the grid's last axis and the horizontal directions its others, exactly (then a point's
    !> height and horizontal coordinates are its own coordinates, bit for bit).
