@@ -50,7 +50,7 @@ module volume_correction
    implicit none
    private
 
-   public :: part_below      ! for the tests
+   public :: part_below, lowest_height      ! for the tests
 
    !> Samples per cell and axis of the quadrature of V_i (2-D, 3-D); midpoints, so a wall on a node or a
    !> cell face is exact.
