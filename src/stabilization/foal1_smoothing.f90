@@ -13,7 +13,7 @@ module foal1_smoothing
    use particle_set, only: particle_set_t
    use stabilizer, only: stage_context_t
    use c0_anti_locking, only: c0_anti_locking_t
-   use cell_binning, only: cell_list_t, bin_cell_mass_and_centre, cell_average, gather_cell_values, &
+   use cell_binning, only: cell_list_t, bin_cell_mass_and_centre, cell_average, cell_sums, &
                            bin_cell_mass_and_local_moments
    use cell_halo, only: padded_cells_t, exchange_cell_halo, halo_width
    use background_grid, only: grid_t
@@ -28,7 +28,7 @@ module foal1_smoothing
       type(padded_cells_t) :: box
       real(rp), allocatable :: centre(:, :)    !< mass centre x_o^c of the owned cells at x^n (occupied ones)
       ! work arrays kept between steps
-      real(rp), allocatable :: q_cell(:, :), field(:, :), dq(:, :)
+      real(rp), allocatable :: q_cell(:, :), field(:, :), dq(:, :)   ! q_cell: the sums m_c q_c
       logical, allocatable :: exists(:)
       integer, allocatable :: packed(:)        !< packed(1:n_packed): owned cells written into `field` by the last step
       integer :: n_packed = 0
@@ -93,7 +93,7 @@ contains
 
       call ensure_work_arrays(self, nq, dim, context%grid%cell_count)
 
-      ! (c) cell averages of q on the owned cells
+      ! (c) the sums m_c q_c on the owned cells (pack_cells divides them by m_c)
       associate (q_cell => self%q_cell, field => self%field, dq => self%dq, exists => self%exists, &
                  of_owned => self%box%of_owned)
          if (self%pressure_only) then
@@ -101,9 +101,9 @@ contains
             do p = first, last
                q(1, p - first + 1) = -(particles%sbar(1, p) + particles%sbar(2, p) + particles%sbar(3, p)) / 3.0_rp
             end do
-            call cell_average(particles, first, last, self%occupied, self%cell_mass, q, q_cell)
+            call cell_sums(particles, first, last, self%occupied, q, q_cell)
          else
-            call cell_average(particles, first, last, self%occupied, self%cell_mass, particles%sbar(:, first:last), q_cell)
+            call cell_sums(particles, first, last, self%occupied, particles%sbar(:, first:last), q_cell)
          end if
 
          ! padded cell field: exists, m_c, x_o^c, q_c; ghost layers from the neighbours (collective). Rows
@@ -142,13 +142,15 @@ contains
                particles%sbar(1:3, p) = particles%sbar(1:3, p) - dq(1, of_owned(c))
             end do
          else if (self%cell_averaging) then
-            ! q^_c = q_c + dq_c per owned cell (eq. 13), then a plain gather
-            if (nq == 4) then
-               call add_increments(4, self%occupied, of_owned, self%cell_mass, dq, q_cell)
+            ! q_p := q^_c = q_c + dq_c (eq. 13), q_c as packed
+            if (dim == 2 .and. nq == 4) then
+               call gather_smoothed(2, 4, particles%cell(first:last), of_owned, field, dq, particles%sbar(:, first:last))
+            else if (dim == 3 .and. nq == 6) then
+               call gather_smoothed(3, 6, particles%cell(first:last), of_owned, field, dq, particles%sbar(:, first:last))
             else
-               call add_increments(nq, self%occupied, of_owned, self%cell_mass, dq, q_cell)
+               call gather_smoothed(dim, nq, particles%cell(first:last), of_owned, field, dq, &
+                                    particles%sbar(:, first:last))
             end if
-            call gather_cell_values(particles%cell(first:last), q_cell, particles%sbar(:, first:last))
          else
             do p = first, last
                particles%sbar(:, p) = particles%sbar(:, p) + dq(:, of_owned(particles%cell(p)))
@@ -158,42 +160,52 @@ contains
    end subroutine foal1_filter_stress
 
    !> field(:, of_owned(c)) := [1, m_c, x_o^c, q_c] for the listed cells c holding the material,
-   !> field(1, of_owned(c)) := 0 for the others; exists likewise. dim and nq are literals at the
-   !> calls that matter (a section copy of unknown length per cell is a library call).
-   subroutine pack_cells(dim, nq, occupied, of_owned, cell_mass, centre, q_cell, field, exists)
+   !> field(1, of_owned(c)) := 0 for the others (their other rows are not read); exists likewise.
+   !> q_c = sums(:, c) / m_c: the division of cell_binning's cell_average, here rather than in a pass of its
+   !> own, and like it unconditional (by 1 where m_c = 0) so that it is one vector division: under a test
+   !> gcc left n scalar ones. dim and nq are literals at the calls that matter (a section copy of unknown
+   !> length per cell is a library call).
+   subroutine pack_cells(dim, nq, occupied, of_owned, cell_mass, centre, sums, field, exists)
       integer, intent(in) :: dim, nq, of_owned(:)
       type(cell_list_t), intent(in) :: occupied
-      real(rp), intent(in) :: cell_mass(:), centre(dim, *), q_cell(nq, *)
+      real(rp), intent(in) :: cell_mass(:), centre(dim, *), sums(nq, *)
       real(rp), intent(inout) :: field(2 + dim + nq, *)
       logical, intent(inout) :: exists(:)
       integer :: c, i, k
+      real(rp) :: m
       do k = 1, occupied%count
          c = occupied%cells(k)
          i = of_owned(c)
-         exists(i) = cell_mass(c) > 0.0_rp
-         if (exists(i)) then
-            field(1, i) = 1.0_rp
-            field(2, i) = cell_mass(c)
-            field(3:2 + dim, i) = centre(:, c)
-            field(3 + dim:, i) = q_cell(:, c)
-         else
-            field(1, i) = 0.0_rp
-         end if
+         m = cell_mass(c)
+         exists(i) = m > 0.0_rp
+         field(1, i) = merge(1.0_rp, 0.0_rp, m > 0.0_rp)
+         field(2, i) = m
+         field(3:2 + dim, i) = centre(:, c)
+         field(3 + dim:, i) = sums(:, c) / merge(m, 1.0_rp, m > 0.0_rp)
       end do
    end subroutine pack_cells
 
-   !> q_cell(:, c) := q_c + dq_c (eq. 13) for the listed cells holding the material.
-   subroutine add_increments(nq, occupied, of_owned, cell_mass, dq, q_cell)
-      integer, intent(in) :: nq, of_owned(:)
-      type(cell_list_t), intent(in) :: occupied
-      real(rp), intent(in) :: cell_mass(:), dq(nq, *)
-      real(rp), intent(inout) :: q_cell(nq, *)
-      integer :: c, k
-      do k = 1, occupied%count
-         c = occupied%cells(k)
-         if (cell_mass(c) > 0.0_rp) q_cell(:, c) = q_cell(:, c) + dq(:, of_owned(c))
+   !> values(:, i) := q_c + dq_c (eq. 13) of particle i's cell c = cell(i), q_c from the packed cell field.
+   !> The particles come sorted by cell: the sum is formed once per run of one cell (the same addition as per
+   !> cell), and a cell's values are stored as one vector per particle.
+   subroutine gather_smoothed(dim, nq, cell, of_owned, field, dq, values)
+      integer, intent(in) :: dim, nq, cell(:), of_owned(:)
+      real(rp), intent(in) :: field(2 + dim + nq, *), dq(nq, *)
+      real(rp), intent(inout) :: values(nq, *)
+      real(rp) :: smoothed(nq)
+      integer :: p, c, i
+      c = 0
+      smoothed = 0.0_rp
+      !GCC$ novector
+      do p = 1, size(cell)
+         if (cell(p) /= c) then
+            c = cell(p)
+            i = of_owned(c)
+            smoothed = field(3 + dim:2 + dim + nq, i) + dq(:, i)
+         end if
+         values(:, p) = smoothed
       end do
-   end subroutine add_increments
+   end subroutine gather_smoothed
 
    !> Size the work arrays for nq smoothed values on the current cells (kept while the sizes hold). A new
    !> `field` starts at 0 and `exists` false: ghost cells no exchange writes (beyond the grid) stay so.

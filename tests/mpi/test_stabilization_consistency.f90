@@ -6,7 +6,9 @@
 !>  - C0's and FOAL1's rate from the grid (cell_strain_rate) is the cell average of the particles' rates, in
 !>    2-D and 3-D (<= 1e-12 relative), with particles off the lattice;
 !>  - NB of the only material takes the grid's mass row of P2G for its own nodal masses, bit for bit;
-!>  - FOAL1 and NB of two materials keep each material's sum m_p s_p.
+!>  - FOAL1 and NB of two materials keep each material's sum m_p s_p;
+!>  - FOAL1's stress stage sets every particle to q_c + dq_c of its cell, with q_c, m_c and x_o^c summed
+!>    here particle by particle and dq_c from limited_flux_increments on those cell data (2-D and 3-D).
 module test_stabilization_consistency
    use kinds, only: rp, i8
    use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_split, MPI_Comm_free, MPI_Allreduce, MPI_Bcast, &
@@ -23,6 +25,10 @@ module test_stabilization_consistency
    use node_halo, only: sum_shared_nodes
    use shape_functions, only: n_corners, corner_offset, shape_values_and_gradients
    use test_scenes, only: water_scene, add_body
+   use foal1_smoothing, only: foal1_smoothing_t
+   use input_text, only: real_text, int_text
+   use cell_halo, only: padded_cells_t
+   use limited_flux_smoothing, only: flux_options_t, flux_workspace_t, limited_flux_increments
    implicit none
    private
 
@@ -31,7 +37,7 @@ module test_stabilization_consistency
              test_random_field_3d_rank_invariance, &
              test_gamma_zero_is_c0, test_c0_is_one_point_quadrature_2d, test_nb_sole_material_grid_mass, &
              test_c0_rate_from_grid_2d, test_c0_rate_from_grid_3d, test_foal1_rate_from_grid_2d, &
-             test_foal1_rate_from_grid_3d
+             test_foal1_rate_from_grid_3d, test_foal1_particles_take_the_cell_smoothing
 
    integer, parameter :: random_field = 1, checkerboard = 2
 
@@ -509,4 +515,85 @@ contains
                        scheme_name//': d~_c from the grid = the cell average of the particle rates')
       call solver%free()
    end subroutine compare_rate_from_grid
+   !> FOAL1's stress stage (cell sums, packing with the division by m_c, halo, fluxes, and the particle update
+   !> q_p := q_c + dq_c of eq. 13) against the same update assembled here from its parts: m_c, x_o^c and q_c
+   !> summed particle by particle, dq_c from limited_flux_increments on those cell data. On one rank (the
+   !> fluxes of a rank's border cells need its neighbours' cells; 1 against N ranks is compare_smoothing).
+   subroutine test_foal1_particles_take_the_cell_smoothing(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(MPI_Comm) :: serial
+      integer :: rank
+      call MPI_Comm_rank(comm, rank)
+      call MPI_Comm_split(comm, merge(0, MPI_UNDEFINED, rank == 0), 0, serial)
+      if (.not. (serial /= MPI_COMM_NULL)) return
+      call check_particle_update(serial, 2)
+      call check_particle_update(serial, 3)
+      call MPI_Comm_free(serial)
+   end subroutine test_foal1_particles_take_the_cell_smoothing
+
+   subroutine check_particle_update(comm, dim)
+      type(MPI_Comm), intent(in) :: comm
+      integer, intent(in) :: dim
+      type(solver_t), target :: solver
+      type(status_t) :: status
+      type(padded_cells_t) :: box
+      type(flux_options_t) :: options
+      type(flux_workspace_t) :: workspace
+      real(rp), allocatable :: mass(:), centre(:, :), q(:, :), dq(:, :), expected(:, :)   ! (padded cells)
+      logical, allocatable :: exists(:)
+      integer :: p, i, nq
+      real(rp) :: worst, largest_change
+
+      call solver%init(block_scene(dim, 'FOAL1'), comm, status)
+      call assertTrue(status%ok, 'solver init: '//trim(status%message))
+      nq = solver%particles%n_sigma
+      do p = 1, solver%particles%count      ! off the lattice: mass centres not at the cell centres
+         solver%particles%sbar(:, p) = value_of(solver%particles%id(p), [0, 0, 0], random_field, nq)
+         solver%particles%x(:, p) = solver%particles%x(:, p) + 0.02_rp * (hash01(7 * solver%particles%id(p)) - 0.5_rp)
+      end do
+      select type (scheme => solver%schemes(1)%scheme)
+      type is (foal1_smoothing_t)
+         options = scheme%options
+      class default
+         call assertTrue(.false., 'the material runs FOAL1')
+      end select
+
+      ! the cell data, summed here by the particles' cells (particles%cell, as FOAL1 bins them)
+      call box%init(solver%grid)
+      allocate (mass(box%count), centre(dim, box%count), q(nq, box%count), dq(nq, box%count), exists(box%count))
+      mass = 0.0_rp
+      centre = 0.0_rp
+      q = 0.0_rp
+      do p = 1, solver%particles%count
+         i = box%of_owned(solver%particles%cell(p))
+         mass(i) = mass(i) + solver%particles%mass(p)
+         centre(:, i) = centre(:, i) + solver%particles%mass(p) * solver%particles%x(:, p)
+         q(:, i) = q(:, i) + solver%particles%mass(p) * solver%particles%sbar(:, p)
+      end do
+      exists = mass > 0.0_rp
+      do i = 1, box%count
+         if (.not. exists(i)) cycle
+         centre(:, i) = centre(:, i) / mass(i)
+         q(:, i) = q(:, i) / mass(i)
+      end do
+      call limited_flux_increments(box, solver%grid%h, exists, mass, centre, q, options, dq, workspace)
+      allocate (expected(nq, solver%particles%count))
+      do p = 1, solver%particles%count
+         i = box%of_owned(solver%particles%cell(p))
+         expected(:, p) = q(:, i) + dq(:, i)
+      end do
+
+      call smooth_stress(solver, 1)
+      worst = 0.0_rp
+      do p = 1, solver%particles%count
+         worst = max(worst, maxval(abs(solver%particles%sbar(:, p) - expected(:, p))))
+      end do
+      largest_change = maxval(abs(dq))
+      call assertTrue(largest_change > 10.0_rp, int_text(dim)//'-D: the fluxes change the cell averages, by up to '// &
+                      real_text(largest_change))
+      call assertTrue(worst <= 1.0e-12_rp * maxval(abs(expected)), int_text(dim)//'-D: q_p = q_c + dq_c, largest '// &
+                      'difference '//real_text(worst))
+      call solver%free()
+   end subroutine check_particle_update
+
 end module test_stabilization_consistency
