@@ -25,9 +25,9 @@ module cell_binning
       integer, allocatable :: cells(:)     !< cells(1:count); sized to the rank's cells
    end type cell_list_t
 
-   public :: start_cell_list, bin_cell_mass, bin_cell_mass_and_centre, cell_average, replace_by_cell_average
+   public :: start_cell_list, bin_cell_mass, bin_cell_mass_and_centre, cell_average, cell_sums, replace_by_cell_average
    public :: bin_cell_mass_and_local_moments, bin_cell_mass_and_mean
-   public :: divide_by_cell_mass, gather_cell_values, start_of_run
+   public :: divide_by_cell_mass, gather_cell_values
 
 contains
 
@@ -139,23 +139,40 @@ contains
       type(cell_list_t), intent(in) :: occupied
       real(rp), intent(in) :: cell_mass(:), values(:, :)
       real(rp), intent(inout) :: average(:, :)
+      if (last < first) return
+      call cell_sums(particles, first, last, occupied, values, average)
+      select case (size(values, 1))    ! literal sizes: the division per cell too (a runtime n cost 48 instructions per cell)
+      case (4)
+         call divide_by_cell_mass(4, occupied, cell_mass, average)
+      case (6)
+         call divide_by_cell_mass(6, occupied, cell_mass, average)
+      case default
+         call divide_by_cell_mass(size(values, 1), occupied, cell_mass, average)
+      end select
+   end subroutine cell_average
+
+   !> sums(:, c) = sum m_p values(:, p) over the particles first..last: cell_average's sums, before its division
+   !> by m_c (FOAL1 divides as it packs the cells). Arguments as cell_average's.
+   subroutine cell_sums(particles, first, last, occupied, values, sums)
+      type(particle_set_t), intent(in) :: particles
+      integer, intent(in) :: first, last
+      type(cell_list_t), intent(in) :: occupied
+      real(rp), intent(in) :: values(:, :)
+      real(rp), intent(inout) :: sums(:, :)
       integer :: n
       n = size(values, 1)
       if (last < first) return
       associate (cell => particles%cell(first:last), mass => particles%mass(first:last))
-         select case (n)     ! literal sizes: the division per cell too (a runtime n cost 48 instructions per cell)
+         select case (n)
          case (4)
-            call mass_weighted_sums(4, occupied, cell, mass, values, average)
-            call divide_by_cell_mass(4, occupied, cell_mass, average)
+            call mass_weighted_sums(4, occupied, cell, mass, values, sums)
          case (6)
-            call mass_weighted_sums(6, occupied, cell, mass, values, average)
-            call divide_by_cell_mass(6, occupied, cell_mass, average)
+            call mass_weighted_sums(6, occupied, cell, mass, values, sums)
          case default
-            call mass_weighted_sums(n, occupied, cell, mass, values, average)
-            call divide_by_cell_mass(n, occupied, cell_mass, average)
+            call mass_weighted_sums(n, occupied, cell, mass, values, sums)
          end select
       end associate
-   end subroutine cell_average
+   end subroutine cell_sums
 
    !> Replace values(:, p) of particles first..last by the average of their cell (C0: "replace, not
    !> increment" [P]+[D], algorithms.md section 2.2).
@@ -256,31 +273,21 @@ contains
          if (cell(i) /= c) then
             sums(:, c) = running
             c = cell(i)
-            call start_of_run(n, occupied, c, next, sums, running)
+            if (next <= occupied%count) then
+               if (c == occupied%cells(next)) then
+                  next = next + 1
+                  running = 0.0_rp
+               else
+                  running = sums(:, c)
+               end if
+            else
+               running = sums(:, c)
+            end if
          end if
          running = running + mass(i) * values(:, i)
       end do
       sums(:, c) = running
    end subroutine mass_weighted_sums
-
-   !> The sum a run of particles on cell c starts from, in mass_weighted_sums and its like (FOAL1's sum_and_pack):
-   !> 0 when c is the list's next cell (its first visit; `next` then moves on), else the sum stored when the cell
-   !> was last left.
-   pure subroutine start_of_run(n, occupied, c, next, sums, running)
-      integer, intent(in) :: n, c
-      type(cell_list_t), intent(in) :: occupied
-      integer, intent(inout) :: next
-      real(rp), intent(in) :: sums(n, *)
-      real(rp), intent(out) :: running(n)
-      if (next <= occupied%count) then
-         if (c == occupied%cells(next)) then
-            next = next + 1
-            running = 0.0_rp
-            return
-         end if
-      end if
-      running = sums(:, c)
-   end subroutine start_of_run
 
    subroutine mass_and_moment_sums(n, cell, mass, x, cell_mass, moment, list, count)
       integer, intent(in) :: n, cell(:)

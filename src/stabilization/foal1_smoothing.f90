@@ -13,8 +13,8 @@ module foal1_smoothing
    use particle_set, only: particle_set_t
    use stabilizer, only: stage_context_t
    use c0_anti_locking, only: c0_anti_locking_t
-   use cell_binning, only: cell_list_t, bin_cell_mass_and_centre, cell_average, &
-                           bin_cell_mass_and_local_moments, start_of_run
+   use cell_binning, only: cell_list_t, bin_cell_mass_and_centre, cell_average, cell_sums, &
+                           bin_cell_mass_and_local_moments
    use cell_halo, only: padded_cells_t, exchange_cell_halo, halo_width
    use background_grid, only: grid_t
    use limited_flux_smoothing, only: flux_options_t, flux_workspace_t, field_flux_increments
@@ -93,38 +93,36 @@ contains
 
       call ensure_work_arrays(self, nq, dim, context%grid%cell_count)
 
-      ! (c) the cell averages q_c, packed with m_c and x_o^c into the padded cell field (with `exists`); ghost
-      ! layers from the neighbours (collective). Rows other than "exists" are read only where it is set. Only
-      ! the occupied cells are written: first clear the cells the last step wrote that hold none of the
-      ! material now (m_c = 0: unlisted); the rest of `field` and `exists` stays 0 from allocation, or is
-      ! rewritten by every exchange.
+      ! (c) the sums m_c q_c on the owned cells (pack_cells divides them by m_c)
       associate (q_cell => self%q_cell, field => self%field, dq => self%dq, exists => self%exists, &
                  of_owned => self%box%of_owned)
+         if (self%pressure_only) then
+            allocate (q(nq, max(0, last - first + 1)))
+            do p = first, last
+               q(1, p - first + 1) = -(particles%sbar(1, p) + particles%sbar(2, p) + particles%sbar(3, p)) / 3.0_rp
+            end do
+            call cell_sums(particles, first, last, self%occupied, q, q_cell)
+         else
+            call cell_sums(particles, first, last, self%occupied, particles%sbar(:, first:last), q_cell)
+         end if
+
+         ! padded cell field: exists, m_c, x_o^c, q_c; ghost layers from the neighbours (collective). Rows
+         ! other than "exists" are read only where it is set. Only the occupied cells are written: first
+         ! clear the cells the last step wrote that hold none of the material now (m_c = 0: unlisted);
+         ! the rest of `field` and `exists` stays 0 from allocation, or is rewritten by every exchange.
          do i = 1, self%n_packed
             c = self%packed(i)
             if (self%cell_mass(c) > 0.0_rp) cycle
             field(1, of_owned(c)) = 0.0_rp
             exists(of_owned(c)) = .false.
          end do
-         associate (cell => particles%cell(first:last), mass => particles%mass(first:last))
-            if (self%pressure_only) then
-               allocate (q(nq, max(0, last - first + 1)))
-               do p = first, last
-                  q(1, p - first + 1) = -(particles%sbar(1, p) + particles%sbar(2, p) + particles%sbar(3, p)) / 3.0_rp
-               end do
-               call sum_and_pack(dim, 1, self%occupied, cell, mass, q, self%cell_mass, self%centre, of_owned, q_cell, &
-                                 field, exists)
-            else if (dim == 2 .and. nq == 4) then
-               call sum_and_pack(2, 4, self%occupied, cell, mass, particles%sbar(:, first:last), self%cell_mass, &
-                                 self%centre, of_owned, q_cell, field, exists)
-            else if (dim == 3 .and. nq == 6) then
-               call sum_and_pack(3, 6, self%occupied, cell, mass, particles%sbar(:, first:last), self%cell_mass, &
-                                 self%centre, of_owned, q_cell, field, exists)
-            else
-               call sum_and_pack(dim, nq, self%occupied, cell, mass, particles%sbar(:, first:last), self%cell_mass, &
-                                 self%centre, of_owned, q_cell, field, exists)
-            end if
-         end associate
+         if (dim == 2 .and. nq == 4) then
+            call pack_cells(2, 4, self%occupied, of_owned, self%cell_mass, self%centre, q_cell, field, exists)
+         else if (dim == 3 .and. nq == 6) then
+            call pack_cells(3, 6, self%occupied, of_owned, self%cell_mass, self%centre, q_cell, field, exists)
+         else
+            call pack_cells(dim, nq, self%occupied, of_owned, self%cell_mass, self%centre, q_cell, field, exists)
+         end if
          self%n_packed = self%occupied%count
          self%packed(1:self%n_packed) = self%occupied%cells(1:self%n_packed)
          call exchange_cell_halo(context%domain, context%grid, self%box, field, flags=exists)
@@ -161,54 +159,31 @@ contains
       end associate
    end subroutine foal1_filter_stress
 
-   !> The sums m_c q_c = sum m_p q_p over the particles of each listed cell (as cell_binning's cell_average
-   !> forms them: kept along a run of particles of one cell, continued from `sums` when the cell comes again,
-   !> a run on the list's next cell being that cell's first), and with them the packed cell field: at the end of
-   !> every run field(:, of_owned(c)) := [1, m_c, x_o^c, q_c], q_c = sums / m_c. A cell met again is packed
-   !> again, so its last packing holds all its particles. One pass where the sums and the packing took two.
-   !> dim and nq are literals at the calls that matter (a section copy of unknown length is a library call).
-   subroutine sum_and_pack(dim, nq, occupied, cell, mass, values, cell_mass, centre, of_owned, sums, field, exists)
-      integer, intent(in) :: dim, nq, cell(:), of_owned(:)
+   !> field(:, of_owned(c)) := [1, m_c, x_o^c, q_c] for the listed cells c holding the material,
+   !> field(1, of_owned(c)) := 0 for the others (their other rows are not read); exists likewise.
+   !> q_c = sums(:, c) / m_c: the division of cell_binning's cell_average, here rather than in a pass of its
+   !> own, and like it unconditional (by 1 where m_c = 0) so that it is one vector division: under a test
+   !> gcc left n scalar ones. dim and nq are literals at the calls that matter (a section copy of unknown
+   !> length per cell is a library call).
+   subroutine pack_cells(dim, nq, occupied, of_owned, cell_mass, centre, sums, field, exists)
+      integer, intent(in) :: dim, nq, of_owned(:)
       type(cell_list_t), intent(in) :: occupied
-      real(rp), intent(in) :: mass(:), values(nq, *), cell_mass(:), centre(dim, *)
-      real(rp), intent(inout) :: sums(nq, *), field(2 + dim + nq, *)
+      real(rp), intent(in) :: cell_mass(:), centre(dim, *), sums(nq, *)
+      real(rp), intent(inout) :: field(2 + dim + nq, *)
       logical, intent(inout) :: exists(:)
-      real(rp) :: running(nq)
-      integer :: p, c, next
-      if (size(cell) == 0 .or. occupied%count == 0) return
-      c = cell(1)
-      running = 0.0_rp
-      next = 2
-      do p = 1, size(cell)
-         if (cell(p) /= c) then
-            call pack_cell(dim, nq, c, running, cell_mass, centre, of_owned, sums, field, exists)
-            c = cell(p)
-            call start_of_run(nq, occupied, c, next, sums, running)
-         end if
-         running = running + mass(p) * values(:, p)
-      end do
-      call pack_cell(dim, nq, c, running, cell_mass, centre, of_owned, sums, field, exists)
-   end subroutine sum_and_pack
-
-   !> sums(:, c) := sum, and field(:, of_owned(c)) := [1, m_c, x_o^c, sum / m_c] (flag 0 where m_c = 0; the
-   !> division unconditional, by 1 there, so that it is one vector division: under a test gcc left nq scalar
-   !> ones).
-   subroutine pack_cell(dim, nq, c, sum, cell_mass, centre, of_owned, sums, field, exists)
-      integer, intent(in) :: dim, nq, c, of_owned(:)
-      real(rp), intent(in) :: sum(nq), cell_mass(:), centre(dim, *)
-      real(rp), intent(inout) :: sums(nq, *), field(2 + dim + nq, *)
-      logical, intent(inout) :: exists(:)
-      integer :: i
+      integer :: c, i, k
       real(rp) :: m
-      sums(:, c) = sum
-      i = of_owned(c)
-      m = cell_mass(c)
-      exists(i) = m > 0.0_rp
-      field(1, i) = merge(1.0_rp, 0.0_rp, m > 0.0_rp)
-      field(2, i) = m
-      field(3:2 + dim, i) = centre(:, c)
-      field(3 + dim:, i) = sum / merge(m, 1.0_rp, m > 0.0_rp)
-   end subroutine pack_cell
+      do k = 1, occupied%count
+         c = occupied%cells(k)
+         i = of_owned(c)
+         m = cell_mass(c)
+         exists(i) = m > 0.0_rp
+         field(1, i) = merge(1.0_rp, 0.0_rp, m > 0.0_rp)
+         field(2, i) = m
+         field(3:2 + dim, i) = centre(:, c)
+         field(3 + dim:, i) = sums(:, c) / merge(m, 1.0_rp, m > 0.0_rp)
+      end do
+   end subroutine pack_cells
 
    !> values(:, i) := q_c + dq_c (eq. 13) of particle i's cell c = cell(i), q_c from the packed cell field.
    !> The particles come sorted by cell: the sum is formed once per run of one cell (the same addition as per
