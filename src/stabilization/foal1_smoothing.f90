@@ -28,7 +28,7 @@ module foal1_smoothing
       type(padded_cells_t) :: box
       real(rp), allocatable :: centre(:, :)    !< mass centre x_o^c of the owned cells at x^n (occupied ones)
       ! work arrays kept between steps
-      real(rp), allocatable :: q_cell(:, :), field(:, :), dq(:, :)   ! q_cell: the sums m_c q_c
+      real(rp), allocatable :: q_sums(:, :), field(:, :), dq(:, :)   !< q_sums: m_c q_c of the owned cells
       logical, allocatable :: exists(:)
       integer, allocatable :: packed(:)        !< packed(1:n_packed): owned cells written into `field` by the last step
       integer :: n_packed = 0
@@ -50,7 +50,7 @@ contains
       call self%size_cell_arrays(context%grid%cell_count, particles%n_sigma)
       if (.not. same_cells(self%box, context%grid)) then
          call self%box%init(context%grid)
-         if (allocated(self%q_cell)) deallocate (self%q_cell, self%field, self%dq, self%exists, self%packed)   ! a new layout
+         if (allocated(self%q_sums)) deallocate (self%q_sums, self%field, self%dq, self%exists, self%packed)   ! a new layout
       end if
       if (allocated(self%centre)) then
          if (size(self%centre, 2) /= context%grid%cell_count) deallocate (self%centre)
@@ -94,16 +94,16 @@ contains
       call ensure_work_arrays(self, nq, dim, context%grid%cell_count)
 
       ! (c) the sums m_c q_c on the owned cells (pack_cells divides them by m_c)
-      associate (q_cell => self%q_cell, field => self%field, dq => self%dq, exists => self%exists, &
+      associate (q_sums => self%q_sums, field => self%field, dq => self%dq, exists => self%exists, &
                  of_owned => self%box%of_owned)
          if (self%pressure_only) then
             allocate (q(nq, max(0, last - first + 1)))
             do p = first, last
                q(1, p - first + 1) = -(particles%sbar(1, p) + particles%sbar(2, p) + particles%sbar(3, p)) / 3.0_rp
             end do
-            call cell_sums(particles, first, last, self%occupied, q, q_cell)
+            call cell_sums(particles, first, last, self%occupied, q, q_sums)
          else
-            call cell_sums(particles, first, last, self%occupied, particles%sbar(:, first:last), q_cell)
+            call cell_sums(particles, first, last, self%occupied, particles%sbar(:, first:last), q_sums)
          end if
 
          ! padded cell field: exists, m_c, x_o^c, q_c; ghost layers from the neighbours (collective). Rows
@@ -117,11 +117,11 @@ contains
             exists(of_owned(c)) = .false.
          end do
          if (dim == 2 .and. nq == 4) then
-            call pack_cells(2, 4, self%occupied, of_owned, self%cell_mass, self%centre, q_cell, field, exists)
+            call pack_cells(2, 4, self%occupied, of_owned, self%cell_mass, self%centre, q_sums, field, exists)
          else if (dim == 3 .and. nq == 6) then
-            call pack_cells(3, 6, self%occupied, of_owned, self%cell_mass, self%centre, q_cell, field, exists)
+            call pack_cells(3, 6, self%occupied, of_owned, self%cell_mass, self%centre, q_sums, field, exists)
          else
-            call pack_cells(dim, nq, self%occupied, of_owned, self%cell_mass, self%centre, q_cell, field, exists)
+            call pack_cells(dim, nq, self%occupied, of_owned, self%cell_mass, self%centre, q_sums, field, exists)
          end if
          self%n_packed = self%occupied%count
          self%packed(1:self%n_packed) = self%occupied%cells(1:self%n_packed)
@@ -212,11 +212,11 @@ contains
    subroutine ensure_work_arrays(self, nq, dim, cell_count)
       type(foal1_smoothing_t), intent(inout) :: self
       integer, intent(in) :: nq, dim, cell_count
-      if (allocated(self%q_cell)) then
-         if (size(self%q_cell, 2) == cell_count .and. size(self%field, 2) == self%box%count) return
-         deallocate (self%q_cell, self%field, self%dq, self%exists, self%packed)
+      if (allocated(self%q_sums)) then
+         if (size(self%q_sums, 2) == cell_count .and. size(self%field, 2) == self%box%count) return
+         deallocate (self%q_sums, self%field, self%dq, self%exists, self%packed)
       end if
-      allocate (self%q_cell(nq, cell_count), self%field(2 + dim + nq, self%box%count), self%dq(nq, self%box%count), &
+      allocate (self%q_sums(nq, cell_count), self%field(2 + dim + nq, self%box%count), self%dq(nq, self%box%count), &
                 self%exists(self%box%count), self%packed(cell_count))
       self%field = 0.0_rp
       self%exists = .false.

@@ -15,7 +15,7 @@ module test_stabilization_consistency
    use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_split, MPI_Comm_free, MPI_Allreduce, MPI_Bcast, &
                       MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_SUM, MPI_UNDEFINED, MPI_COMM_NULL, operator(/=)
    use assertions, only: assertTrue, assertEqual
-   use reproducible_numbers, only: hash01
+   use reproducible_numbers, only: hash01, mirror_swaps
    use error_status, only: status_t
    use scene_description, only: scene_t
    use mpm_solver, only: solver_t
@@ -516,6 +516,7 @@ contains
                        scheme_name//': d~_c from the grid = the cell average of the particle rates')
       call solver%free()
    end subroutine compare_rate_from_grid
+
    !> FOAL1's stress stage (cell sums, packing with the division by m_c, halo, fluxes, and the particle update
    !> q_p := q_c + dq_c of eq. 13) against the same update assembled here from its parts: m_c, x_o^c and q_c
    !> summed particle by particle, dq_c from limited_flux_increments on those cell data. On one rank (the
@@ -543,7 +544,7 @@ contains
       real(rp), allocatable :: mass(:), centre(:, :), q(:, :), dq(:, :), expected(:, :)   ! (padded cells)
       logical, allocatable :: exists(:)
       integer, allocatable :: dest(:)
-      integer :: p, i, nq, n
+      integer :: p, i, nq
       real(rp) :: worst, largest_change
 
       call solver%init(block_scene(dim, 'FOAL1'), comm, status)
@@ -555,13 +556,7 @@ contains
       end do
       ! out of cell order (every 7th particle swapped with its mirror): cells come in several runs, and a run
       ! continues a sum left earlier (one material: the permutation keeps its range)
-      n = solver%particles%count
-      allocate (dest(n))
-      dest = [(p, p = 1, n)]
-      do p = 3, n / 2, 7
-         dest(p) = n + 1 - p
-         dest(n + 1 - p) = p
-      end do
+      dest = mirror_swaps(solver%particles%count, 3, 7)
       call solver%particles%permute(dest)
       select type (scheme => solver%schemes(1)%scheme)
       type is (foal1_smoothing_t)
@@ -607,5 +602,4 @@ contains
                       'difference '//real_text(worst))
       call solver%free()
    end subroutine check_particle_update
-
 end module test_stabilization_consistency
