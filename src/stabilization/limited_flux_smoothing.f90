@@ -292,6 +292,9 @@ contains
 
    !> The limited flux across the face (c, c + stride of axis k), if both cells exist, at least one is
    !> owned, and the face is active for some component; added to dq of the owned side(s).
+   !> One division per face: 1 / (m_- + m_+) serves x_m (eq. 8) and every value's flux (eq. 11), which
+   !> the general code below divides by one at a time (a division per value on the store's critical path;
+   !> the results differ by round-off, docs/performance.md "FOAL1's face flux with one division").
    subroutine face_flux(dim, nq, box, exists, field, options, oscillating, slope, c, k, dq)
       integer, intent(in) :: dim, nq
       type(padded_cells_t), intent(in) :: box
@@ -301,7 +304,7 @@ contains
       integer, intent(in) :: oscillating(*), c, k
       real(rp), intent(inout) :: dq(nq, *)
       integer :: j, right, active
-      real(rp) :: n_faces, flux, jump, limited_jump, x_m, allowed
+      real(rp) :: n_faces, flux, jump, limited_jump, x_m, allowed, inv_mass, weight
       logical :: owned_minus, owned_plus
       right = c + box%stride(k)
       if (.not. (exists(c) .and. exists(right))) return
@@ -318,13 +321,15 @@ contains
       n_faces = real(2 * dim, rp)
       associate (m_minus => field(2, c), m_plus => field(2, right), x_minus => field(2 + k, c), &
                  x_plus => field(2 + k, right))
-         x_m = (m_minus * x_plus + m_plus * x_minus) / (m_minus + m_plus)         ! eq. 8
+         inv_mass = 1.0_rp / (m_minus + m_plus)
+         x_m = (m_minus * x_plus + m_plus * x_minus) * inv_mass         ! eq. 8
+         weight = options%gamma_max / n_faces * inv_mass
          do j = 1, nq
             if (.not. btest(active, j - 1)) cycle
             jump = field(2 + dim + j, c) - field(2 + dim + j, right)
             allowed = (x_m - x_minus) * slope(j, c) - (x_m - x_plus) * slope(j, right)   ! e_- - e_+
             limited_jump = sign0(jump) * min(max(sign0(jump) * (jump + allowed), 0.0_rp), abs(jump))  ! eq. 12
-            flux = options%gamma_max * limited_jump / (n_faces * (m_minus + m_plus))   ! eqs. 5, 11, 1/n
+            flux = weight * limited_jump   ! eqs. 5, 11, 1/n
             if (owned_plus) dq(j, right) = dq(j, right) + m_minus * flux
             if (owned_minus) dq(j, c) = dq(j, c) - m_plus * flux
          end do
