@@ -304,7 +304,7 @@ contains
       integer, intent(in) :: oscillating(*), c, k
       real(rp), intent(inout) :: dq(nq, *)
       integer :: j, right, active
-      real(rp) :: n_faces, flux, jump, limited_jump, x_m, allowed, inv_mass, weight
+      real(rp) :: n_faces, flux, jump, limited_jump, x_m, allowed, inv_mass, flux_per_jump
       logical :: owned_minus, owned_plus
       right = c + box%stride(k)
       if (.not. (exists(c) .and. exists(right))) return
@@ -322,14 +322,14 @@ contains
       associate (m_minus => field(2, c), m_plus => field(2, right), x_minus => field(2 + k, c), &
                  x_plus => field(2 + k, right))
          inv_mass = 1.0_rp / (m_minus + m_plus)
-         x_m = (m_minus * x_plus + m_plus * x_minus) * inv_mass         ! eq. 8
-         weight = options%gamma_max / n_faces * inv_mass
+         x_m = (m_minus * x_plus + m_plus * x_minus) * inv_mass   ! eq. 8
+         flux_per_jump = options%gamma_max / n_faces * inv_mass   ! eqs. 5, 11, 1/n: gamma / (n (m_- + m_+))
          do j = 1, nq
             if (.not. btest(active, j - 1)) cycle
             jump = field(2 + dim + j, c) - field(2 + dim + j, right)
             allowed = (x_m - x_minus) * slope(j, c) - (x_m - x_plus) * slope(j, right)   ! e_- - e_+
             limited_jump = sign0(jump) * min(max(sign0(jump) * (jump + allowed), 0.0_rp), abs(jump))  ! eq. 12
-            flux = weight * limited_jump   ! eqs. 5, 11, 1/n
+            flux = flux_per_jump * limited_jump
             if (owned_plus) dq(j, right) = dq(j, right) + m_minus * flux
             if (owned_minus) dq(j, c) = dq(j, c) - m_plus * flux
          end do
