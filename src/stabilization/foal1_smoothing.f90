@@ -162,9 +162,10 @@ contains
    !> field(:, of_owned(c)) := [1, m_c, x_o^c, q_c] for the listed cells c holding the material,
    !> field(1, of_owned(c)) := 0 for the others (their other rows are not read); exists likewise.
    !> q_c = sums(:, c) / m_c: the division of cell_binning's cell_average, here rather than in a pass of its
-   !> own, and like it unconditional (by 1 where m_c = 0) so that it is one vector division: under a test
-   !> gcc left n scalar ones. dim and nq are literals at the calls that matter (a section copy of unknown
-   !> length per cell is a library call).
+   !> own, and unconditional (by 1 where m_c = 0: no branch per cell). gcc still divides value by value here
+   !> (it merges the cell's stores into one vector store instead); forcing one vector division saved nothing
+   !> measurable (docs/performance.md, "FOAL1's face flux with one division"). dim and nq are literals at
+   !> the calls that matter (a section copy of unknown length per cell is a library call).
    subroutine pack_cells(dim, nq, occupied, of_owned, cell_mass, centre, sums, field, exists)
       integer, intent(in) :: dim, nq, of_owned(:)
       type(cell_list_t), intent(in) :: occupied
