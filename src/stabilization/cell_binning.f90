@@ -23,11 +23,19 @@ module cell_binning
    type, public :: cell_list_t
       integer :: count = 0
       integer, allocatable :: cells(:)     !< cells(1:count); sized to the rank's cells
+      ! work of replace_by_cell_average: where each listed cell's first run of particles starts (by cell), and
+      ! the starts of the runs that come back to a cell met before (revisits(1:n_revisits))
+      integer, allocatable :: first_run(:), revisits(:)
+      integer :: n_revisits = 0
    end type cell_list_t
 
-   public :: start_cell_list, bin_cell_mass, bin_cell_mass_and_centre, cell_average, cell_sums, replace_by_cell_average
+   public :: start_cell_list, bin_cell_mass, bin_cell_mass_and_centre, cell_average, replace_by_cell_average
    public :: bin_cell_mass_and_local_moments, bin_cell_mass_and_mean
    public :: divide_by_cell_mass, gather_cell_values
+
+   !> Runs coming back to a cell met before that a new cell list notes (replace_by_cell_average; it grows
+   !> when a pass needs more). Public for the tests.
+   integer, parameter, public :: first_revisit_notes = 64
 
 contains
 
@@ -37,7 +45,8 @@ contains
       type(cell_list_t), intent(inout) :: occupied
       real(rp), intent(inout) :: cell_mass(:)
       if (allocated(occupied%cells)) deallocate (occupied%cells)
-      allocate (occupied%cells(cell_count))
+      if (allocated(occupied%first_run)) deallocate (occupied%first_run)
+      allocate (occupied%cells(cell_count), occupied%first_run(cell_count))
       occupied%count = 0
       cell_mass = 0.0_rp
    end subroutine start_cell_list
@@ -152,7 +161,7 @@ contains
    end subroutine cell_average
 
    !> sums(:, c) = sum m_p values(:, p) over the particles first..last: cell_average's sums, before its division
-   !> by m_c (FOAL1 divides as it packs the cells). Arguments as cell_average's.
+   !> by m_c (the order of FOAL1's sum_and_pack too). Arguments as cell_average's.
    subroutine cell_sums(particles, first, last, occupied, values, sums)
       type(particle_set_t), intent(in) :: particles
       integer, intent(in) :: first, last
@@ -175,17 +184,27 @@ contains
    end subroutine cell_sums
 
    !> Replace values(:, p) of particles first..last by the average of their cell (C0: "replace, not
-   !> increment" [P]+[D], algorithms.md section 2.2).
-   !> `average` is work space of at least size(values, 1) * size(cell_mass) values.
+   !> increment" [P]+[D], algorithms.md section 2.2): cell_average's result, bit for bit, in one pass
+   !> (average_runs). `average` is work space of at least size(values, 1) * size(cell_mass) values (it
+   !> holds the cells' sums afterwards); `occupied` keeps the pass's notes.
    subroutine replace_by_cell_average(particles, first, last, occupied, cell_mass, values, average)
       type(particle_set_t), intent(in) :: particles
       integer, intent(in) :: first, last
-      type(cell_list_t), intent(in) :: occupied
+      type(cell_list_t), intent(inout) :: occupied
       real(rp), intent(in) :: cell_mass(:)
       real(rp), intent(inout) :: values(:, :)
       real(rp), intent(inout) :: average(:, :)
-      call cell_average(particles, first, last, occupied, cell_mass, values, average)
-      call gather_cell_values(particles%cell(first:last), average, values)
+      if (last < first) return
+      associate (cell => particles%cell(first:last), mass => particles%mass(first:last))
+         select case (size(values, 1))
+         case (4)
+            call average_runs(4, occupied, cell, mass, cell_mass, values, average)
+         case (6)
+            call average_runs(6, occupied, cell, mass, cell_mass, values, average)
+         case default
+            call average_runs(size(values, 1), occupied, cell, mass, cell_mass, values, average)
+         end select
+      end associate
    end subroutine replace_by_cell_average
 
    !> values(:, i) := cell_values(:, cell(i)), with cell_values read as (size(values, 1), cells).
@@ -371,6 +390,90 @@ contains
       moment(:, c) = running_moment
       if (present(centre)) centre(:, c) = running_centre
    end subroutine mass_and_local_moment_sums
+
+   !> replace_by_cell_average's pass. The sums are mass_weighted_sums', and a run of particles of one cell
+   !> gets the quotient of divide_by_cell_mass as it ends (sum / m_c, while its values are in cache): the
+   !> final average, unless the cell comes back in a later run (a particle that changed cell since the last
+   !> full sort). Those later runs are noted, and once the sums are complete every run of their cells (its
+   !> first and the noted ones) is written again. Where a cell has one run this saves cell_average's pass
+   !> over the cells and the gather's pass over the particles.
+   subroutine average_runs(n, occupied, cell, mass, cell_mass, values, sums)
+      integer, intent(in) :: n, cell(:)
+      type(cell_list_t), intent(inout) :: occupied
+      real(rp), intent(in) :: mass(:), cell_mass(:)
+      real(rp), intent(inout) :: values(n, *), sums(n, *)
+      integer :: i, c, next, start, j, p, n_revisits
+      real(rp) :: running(n), quotient(n)
+      occupied%n_revisits = 0
+      if (occupied%count == 0) return
+      if (.not. allocated(occupied%revisits)) allocate (occupied%revisits(first_revisit_notes))
+      n_revisits = 0
+      c = cell(1)
+      running = 0.0_rp
+      next = 2
+      start = 1
+      occupied%first_run(c) = 1
+      ! (the loop of mass_weighted_sums, with the run's quotient written where the run ends; no call in it: with
+      ! one gcc kept the running sums in memory; the short write loop scalar: gcc had vectorised it over the
+      ! particles with a division for each)
+      do i = 1, size(cell)
+         if (cell(i) /= c) then
+            sums(:, c) = running
+            quotient = running / merge(cell_mass(c), 1.0_rp, cell_mass(c) > 0.0_rp)
+            !GCC$ novector
+            do p = start, i - 1
+               values(:, p) = quotient
+            end do
+            c = cell(i)
+            start = i
+            if (next <= occupied%count) then
+               if (c == occupied%cells(next)) then
+                  next = next + 1
+                  occupied%first_run(c) = i
+                  running = 0.0_rp
+               else
+                  n_revisits = n_revisits + 1
+                  if (n_revisits <= size(occupied%revisits)) occupied%revisits(n_revisits) = i
+                  running = sums(:, c)
+               end if
+            else
+               n_revisits = n_revisits + 1
+               if (n_revisits <= size(occupied%revisits)) occupied%revisits(n_revisits) = i
+               running = sums(:, c)
+            end if
+         end if
+         running = running + mass(i) * values(:, i)
+      end do
+      sums(:, c) = running
+      quotient = running / merge(cell_mass(c), 1.0_rp, cell_mass(c) > 0.0_rp)
+      do p = start, size(cell)
+         values(:, p) = quotient
+      end do
+      occupied%n_revisits = n_revisits
+      if (n_revisits > size(occupied%revisits)) then
+         ! more than the notes hold: the averages gathered as cell_average and gather_cell_values do, and
+         ! room for as many notes next time
+         call divide_by_cell_mass(n, occupied, cell_mass, sums)
+         call gather(n, cell, sums, values)
+         deallocate (occupied%revisits)
+         allocate (occupied%revisits(2 * n_revisits))
+         return
+      end if
+      ! the cells that came back: their first run and every noted one get the final average
+      do j = 1, n_revisits
+         c = cell(occupied%revisits(j))
+         quotient = sums(:, c) / merge(cell_mass(c), 1.0_rp, cell_mass(c) > 0.0_rp)
+         do p = occupied%first_run(c), size(cell)
+            if (cell(p) /= c) exit
+            values(:, p) = quotient
+         end do
+         do p = occupied%revisits(j), size(cell)
+            if (cell(p) /= c) exit
+            values(:, p) = quotient
+         end do
+      end do
+   end subroutine average_runs
+
 
    subroutine gather(n, cell, cell_values, values)
       integer, intent(in) :: n, cell(:)

@@ -13,13 +13,14 @@ module foal1_smoothing
    use particle_set, only: particle_set_t
    use stabilizer, only: stage_context_t
    use c0_anti_locking, only: c0_anti_locking_t
-   use cell_binning, only: cell_list_t, bin_cell_mass_and_centre, cell_average, cell_sums, &
-                           bin_cell_mass_and_local_moments
+   use cell_binning, only: cell_list_t, bin_cell_mass_and_centre, cell_average, bin_cell_mass_and_local_moments
    use cell_halo, only: padded_cells_t, exchange_cell_halo, halo_width
    use background_grid, only: grid_t
    use limited_flux_smoothing, only: flux_options_t, flux_workspace_t, field_flux_increments
    implicit none
    private
+
+   public :: sum_and_pack    ! for the tests
 
    type, extends(c0_anti_locking_t), public :: foal1_smoothing_t
       type(flux_options_t) :: options
@@ -93,19 +94,8 @@ contains
 
       call ensure_work_arrays(self, nq, dim, context%grid%cell_count)
 
-      ! (c) the sums m_c q_c on the owned cells (pack_cells divides them by m_c)
       associate (q_sums => self%q_sums, field => self%field, dq => self%dq, exists => self%exists, &
                  of_owned => self%box%of_owned)
-         if (self%pressure_only) then
-            allocate (q(nq, max(0, last - first + 1)))
-            do p = first, last
-               q(1, p - first + 1) = -(particles%sbar(1, p) + particles%sbar(2, p) + particles%sbar(3, p)) / 3.0_rp
-            end do
-            call cell_sums(particles, first, last, self%occupied, q, q_sums)
-         else
-            call cell_sums(particles, first, last, self%occupied, particles%sbar(:, first:last), q_sums)
-         end if
-
          ! padded cell field: exists, m_c, x_o^c, q_c; ghost layers from the neighbours (collective). Rows
          ! other than "exists" are read only where it is set. Only the occupied cells are written: first
          ! clear the cells the last step wrote that hold none of the material now (m_c = 0: unlisted);
@@ -116,12 +106,23 @@ contains
             field(1, of_owned(c)) = 0.0_rp
             exists(of_owned(c)) = .false.
          end do
-         if (dim == 2 .and. nq == 4) then
-            call pack_cells(2, 4, self%occupied, of_owned, self%cell_mass, self%centre, q_sums, field, exists)
+         ! (c) the sums m_c q_c and the occupied cells' entries, in one pass over the particles
+         if (self%pressure_only) then
+            allocate (q(nq, max(0, last - first + 1)))
+            do p = first, last
+               q(1, p - first + 1) = -(particles%sbar(1, p) + particles%sbar(2, p) + particles%sbar(3, p)) / 3.0_rp
+            end do
+            call sum_and_pack(dim, nq, self%occupied, particles%cell(first:last), particles%mass(first:last), q, &
+                              of_owned, self%cell_mass, self%centre, q_sums, field, exists)
+         else if (dim == 2 .and. nq == 4) then
+            call sum_and_pack(2, 4, self%occupied, particles%cell(first:last), particles%mass(first:last), &
+                              particles%sbar(:, first:last), of_owned, self%cell_mass, self%centre, q_sums, field, exists)
          else if (dim == 3 .and. nq == 6) then
-            call pack_cells(3, 6, self%occupied, of_owned, self%cell_mass, self%centre, q_sums, field, exists)
+            call sum_and_pack(3, 6, self%occupied, particles%cell(first:last), particles%mass(first:last), &
+                              particles%sbar(:, first:last), of_owned, self%cell_mass, self%centre, q_sums, field, exists)
          else
-            call pack_cells(dim, nq, self%occupied, of_owned, self%cell_mass, self%centre, q_sums, field, exists)
+            call sum_and_pack(dim, nq, self%occupied, particles%cell(first:last), particles%mass(first:last), &
+                              particles%sbar(:, first:last), of_owned, self%cell_mass, self%centre, q_sums, field, exists)
          end if
          self%n_packed = self%occupied%count
          self%packed(1:self%n_packed) = self%occupied%cells(1:self%n_packed)
@@ -159,32 +160,62 @@ contains
       end associate
    end subroutine foal1_filter_stress
 
-   !> field(:, of_owned(c)) := [1, m_c, x_o^c, q_c] for the listed cells c holding the material,
-   !> field(1, of_owned(c)) := 0 for the others (their other rows are not read); exists likewise.
-   !> q_c = sums(:, c) / m_c: the division of cell_binning's cell_average, here rather than in a pass of its
-   !> own, and unconditional (by 1 where m_c = 0: no branch per cell). gcc still divides value by value here
-   !> (it merges the cell's stores into one vector store instead); forcing one vector division saved nothing
-   !> measurable (docs/performance.md, "FOAL1's face flux with one division"). dim and nq are literals at
-   !> the calls that matter (a section copy of unknown length per cell is a library call).
-   subroutine pack_cells(dim, nq, occupied, of_owned, cell_mass, centre, sums, field, exists)
-      integer, intent(in) :: dim, nq, of_owned(:)
+   !> Step (c) and the packing of the cell field in one pass over the slice's particles (sorted by cell, nearly):
+   !> the sums m_c q_c of cell_binning's cell_sums, in the same order (kept in `sums`, which a run that comes
+   !> back to a cell continues), and where a run of one cell ends, its entry field(:, of_owned(c)) :=
+   !> [1, m_c, x_o^c, q_c] with q_c = sum / m_c (the division unconditional, by 1 where m_c = 0; exists
+   !> likewise), written while the run's sums are in registers instead of in a pass of its own over the cells.
+   !> A cell whose particles come in more than one run (they changed cell since the last full sort) is
+   !> written at the end of each: the last, with the complete sum, stays. dim and nq are literals at the
+   !> calls that matter.
+   subroutine sum_and_pack(dim, nq, occupied, cell, mass, values, of_owned, cell_mass, centre, sums, field, exists)
+      integer, intent(in) :: dim, nq, cell(:), of_owned(:)
       type(cell_list_t), intent(in) :: occupied
-      real(rp), intent(in) :: cell_mass(:), centre(dim, *), sums(nq, *)
-      real(rp), intent(inout) :: field(2 + dim + nq, *)
+      real(rp), intent(in) :: mass(:), values(nq, *), cell_mass(:), centre(dim, *)
+      real(rp), intent(inout) :: sums(nq, *), field(2 + dim + nq, *)
       logical, intent(inout) :: exists(:)
-      integer :: c, i, k
-      real(rp) :: m
-      do k = 1, occupied%count
-         c = occupied%cells(k)
-         i = of_owned(c)
-         m = cell_mass(c)
-         exists(i) = m > 0.0_rp
-         field(1, i) = merge(1.0_rp, 0.0_rp, m > 0.0_rp)
-         field(2, i) = m
-         field(3:2 + dim, i) = centre(:, c)
-         field(3 + dim:, i) = sums(:, c) / merge(m, 1.0_rp, m > 0.0_rp)
+      integer :: i, c, k, next
+      real(rp) :: running(nq), m
+      if (occupied%count == 0) return
+      c = cell(1)
+      running = 0.0_rp
+      next = 2
+      do i = 1, size(cell)
+         if (cell(i) /= c) then
+            ! the run of cell c ends
+            sums(:, c) = running
+            k = of_owned(c)
+            m = cell_mass(c)
+            exists(k) = m > 0.0_rp
+            field(1, k) = merge(1.0_rp, 0.0_rp, m > 0.0_rp)
+            field(2, k) = m
+            field(3:2 + dim, k) = centre(:, c)
+            field(3 + dim:, k) = running / merge(m, 1.0_rp, m > 0.0_rp)
+            c = cell(i)
+            ! the next cell of the list: its first visit (the runs come in the order the list was made)
+            if (next <= occupied%count) then
+               if (c == occupied%cells(next)) then
+                  next = next + 1
+                  running = 0.0_rp
+               else
+                  running = sums(:, c)
+               end if
+            else
+               running = sums(:, c)
+            end if
+         end if
+         running = running + mass(i) * values(:, i)
       end do
-   end subroutine pack_cells
+      ! the last run ends (the entry as in the loop: a subroutine for it made the tank's FOAL1 slower)
+      sums(:, c) = running
+      k = of_owned(c)
+      m = cell_mass(c)
+      exists(k) = m > 0.0_rp
+      field(1, k) = merge(1.0_rp, 0.0_rp, m > 0.0_rp)
+      field(2, k) = m
+      field(3:2 + dim, k) = centre(:, c)
+      field(3 + dim:, k) = running / merge(m, 1.0_rp, m > 0.0_rp)
+   end subroutine sum_and_pack
 
    !> values(:, i) := q_c + dq_c (eq. 13) of particle i's cell c = cell(i), q_c from the packed cell field.
    !> The particles come sorted by cell: the sum is formed once per run of one cell (the same addition as per
