@@ -452,14 +452,15 @@ contains
       occupied%n_revisits = n_revisits
       if (n_revisits > size(occupied%revisits)) then
          ! more than the notes hold: the averages gathered as cell_average and gather_cell_values do, and
-         ! room for as many notes next time
+         ! room for twice as many notes next time
          call divide_by_cell_mass(n, occupied, cell_mass, sums)
          call gather(n, cell, sums, values)
          deallocate (occupied%revisits)
          allocate (occupied%revisits(2 * n_revisits))
          return
       end if
-      ! the cells that came back: their first run and every noted one get the final average
+      ! the cells that came back: their first run and every noted one get the final average (a first run
+      ! twice where its cell came back twice)
       do j = 1, n_revisits
          c = cell(occupied%revisits(j))
          quotient = sums(:, c) / merge(cell_mass(c), 1.0_rp, cell_mass(c) > 0.0_rp)
@@ -473,7 +474,6 @@ contains
          end do
       end do
    end subroutine average_runs
-
 
    subroutine gather(n, cell, cell_values, values)
       integer, intent(in) :: n, cell(:)
