@@ -175,6 +175,7 @@ contains
       real(rp), intent(inout) :: sums(nq, *), field(2 + dim + nq, *)
       logical, intent(inout) :: exists(:)
       integer :: i, c, k, next
+      logical :: first_visit
       real(rp) :: running(nq), m
       if (occupied%count == 0) return
       c = cell(1)
@@ -193,13 +194,11 @@ contains
             field(3 + dim:, k) = running / merge(m, 1.0_rp, m > 0.0_rp)
             c = cell(i)
             ! the next cell of the list: its first visit (the runs come in the order the list was made)
-            if (next <= occupied%count) then
-               if (c == occupied%cells(next)) then
-                  next = next + 1
-                  running = 0.0_rp
-               else
-                  running = sums(:, c)
-               end if
+            first_visit = .false.
+            if (next <= occupied%count) first_visit = c == occupied%cells(next)
+            if (first_visit) then
+               next = next + 1
+               running = 0.0_rp
             else
                running = sums(:, c)
             end if
