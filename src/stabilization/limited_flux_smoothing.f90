@@ -42,7 +42,9 @@ module limited_flux_smoothing
    type, public :: flux_workspace_t
       integer, allocatable :: oscillating(:)   !< bit j - 1 set: component j oscillates along the current axis
       real(rp), allocatable :: scale(:)
-      real(rp), allocatable :: slope(:)        !< eq. 7 slopes along the current axis, (values, cells)
+      !> eq. 7 slopes along the current axis: (cells, values) in 2-D, (values, cells) in 3-D
+      real(rp), allocatable :: slope(:)
+      real(rp), allocatable :: columns(:)      !< 2-D: q_c, x_o^c and the flag one array each, (cells, values + 3)
       integer :: written_lo(3) = 1, written_hi(3) = 0   !< box of cells of dq the last call may have written
    end type flux_workspace_t
 
@@ -99,16 +101,20 @@ contains
       ! literal sizes for the 2-D and 3-D stress: the compiler unrolls the components and the centre
       if (box%dim == 2) then
          call flux_increments(2, 4, box, h, exists, field, options, lo, hi, workspace%oscillating, workspace%scale, &
-                              workspace%slope, dq)
+                              workspace%slope, workspace%columns, dq)
       else
          call flux_increments(3, 6, box, h, exists, field, options, lo, hi, workspace%oscillating, workspace%scale, &
-                              workspace%slope, dq)
+                              workspace%slope, workspace%columns, dq)
       end if
    end subroutine field_flux_increments
 
    !> The work of field_flux_increments on the bounding box lo:hi of the existing cells, with the
-   !> dimension and the number of values as arguments (literals at the calls that matter).
-   subroutine flux_increments(dim, nq, box, h, exists, field, options, lo, hi, oscillating, scale, slope, dq)
+   !> dimension and the number of values as arguments (literals at the calls that matter). In 2-D the
+   !> flags and slopes of a row are formed in vector lanes from `columns`, the cells' values one array per
+   !> quantity (`(box%count, nq + 3)`: q_c, x_o^c, the flag 1 or 0), and the slopes are (cells, values);
+   !> 3-D keeps the cell-by-cell loop and the slopes (values, cells), a cell's slopes one vector: its rows
+   !> are short, and in lanes it was slower.
+   subroutine flux_increments(dim, nq, box, h, exists, field, options, lo, hi, oscillating, scale, slope, columns, dq)
       integer, intent(in) :: dim, nq, lo(3), hi(3)
       type(padded_cells_t), intent(in) :: box
       real(rp), intent(in) :: h
@@ -116,25 +122,39 @@ contains
       real(rp), intent(in) :: field(2 + dim + nq, *)
       type(flux_options_t), intent(in) :: options
       integer, intent(inout) :: oscillating(*)
-      real(rp), intent(inout) :: scale(*), slope(nq, *), dq(nq, *)
-      integer :: k, c, stride, i1, i2, i3, flo(3), fhi(3), j
+      real(rp), intent(inout) :: scale(*), slope(*), columns(box%count, merge(nq + 3, 0, dim == 2)), &
+                                 dq(nq, *)
+      integer :: k, c, stride, i1, i2, i3, flo(3), fhi(3), j, cell_step, value_step
       real(rp) :: d_min, largest
       d_min = min_centre_distance * h
-      do i3 = lo(3), hi(3)
-         do i2 = lo(2), hi(2)
-            c = flat_index(box, lo(1), i2, i3)
-            do i1 = lo(1), hi(1)
-               if (exists(c)) then     ! round-off scale (see noise_guard); max, not maxval: no NaN tests
-                  largest = abs(field(3 + dim, c))
-                  do j = 2, nq
-                     largest = max(largest, abs(field(2 + dim + j, c)))
-                  end do
-                  scale(c) = noise_guard * largest
-               end if
-               c = c + 1
+      ! slope of value j of cell c: slope(1 + (c - 1) cell_step + (j - 1) value_step)
+      cell_step = merge(1, nq, dim == 2)
+      value_step = merge(box%count, 1, dim == 2)
+      if (dim == 2) then
+         ! lo:hi and the cells around it, which the rows read as neighbours (their flags 0)
+         flo(1:2) = max(lo(1:2) - 1, 1)
+         fhi(1:2) = min(hi(1:2) + 1, box%n(1:2))
+         do i2 = flo(2), fhi(2)
+            call row_columns(nq, box%count, exists, field, flat_index(box, flo(1), i2, 1), fhi(1) - flo(1) + 1, &
+                             columns, scale)
+         end do
+      else
+         do i3 = lo(3), hi(3)
+            do i2 = lo(2), hi(2)
+               c = flat_index(box, lo(1), i2, i3)
+               do i1 = lo(1), hi(1)
+                  if (exists(c)) then     ! round-off scale (see noise_guard); max, not maxval: no NaN tests
+                     largest = abs(field(3 + dim, c))
+                     do j = 2, nq
+                        largest = max(largest, abs(field(2 + dim + j, c)))
+                     end do
+                     scale(c) = noise_guard * largest
+                  end if
+                  c = c + 1
+               end do
             end do
          end do
-      end do
+      end if
       do k = 1, dim
          stride = box%stride(k)
          ! oscillation flags (eq. 6) and slopes (eq. 7) of the cells with both neighbours along k inside
@@ -146,8 +166,13 @@ contains
          do i3 = flo(3), fhi(3)
             do i2 = flo(2), fhi(2)
                c = flat_index(box, flo(1), i2, i3)
-               call row_oscillation_bits(dim, nq, k, exists, scale, field, c, fhi(1) - flo(1) + 1, stride, d_min, &
-                                         oscillating, slope)
+               if (dim == 2) then
+                  call row_flags_in_lanes(nq, box%count, columns(:, nq + 3), scale, columns(:, 1:nq), columns(:, nq + k), &
+                                          c, fhi(1) - flo(1) + 1, stride, d_min, oscillating, slope)
+               else
+                  call row_oscillation_bits(dim, nq, k, exists, scale, field, c, fhi(1) - flo(1) + 1, stride, d_min, &
+                                            oscillating, slope)
+               end if
             end do
          end do
          ! faces (c, c + stride) with c two or more layers inside the box and c + stride in the bounding box
@@ -158,7 +183,8 @@ contains
                c = flat_index(box, flo(1), i2, i3)
                do i1 = flo(1), fhi(1)
                   if (ior(oscillating(c), oscillating(c + stride)) /= 0) &
-                     call face_flux(dim, nq, box, exists, field, options, oscillating, slope, c, k, dq)
+                     call face_flux(dim, nq, box, exists, field, options, oscillating, slope, cell_step, value_step, c, k, &
+                                    dq)
                   c = c + 1
                end do
             end do
@@ -178,12 +204,14 @@ contains
       integer, intent(out) :: lo(3), hi(3)
       if (allocated(workspace%oscillating)) then
          if (size(workspace%oscillating) /= box%count .or. size(workspace%slope) /= nq * box%count) &
-            deallocate (workspace%oscillating, workspace%scale, workspace%slope)
+            deallocate (workspace%oscillating, workspace%scale, workspace%slope, workspace%columns)
       end if
       if (allocated(workspace%oscillating)) then
          call clear_box(nq, box, workspace%written_lo, workspace%written_hi, dq)
       else
-         allocate (workspace%oscillating(box%count), workspace%scale(box%count), workspace%slope(nq * box%count))
+         ! columns: 2-D only (one element otherwise)
+         allocate (workspace%oscillating(box%count), workspace%scale(box%count), workspace%slope(nq * box%count), &
+                   workspace%columns(merge((nq + 3) * box%count, 1, box%dim == 2)))
          dq = 0.0_rp
       end if
       call existing_bounds(box, exists, lo, hi)
@@ -245,10 +273,11 @@ contains
 
    !> Eq. 6 per component for the cells first..first + count - 1 along the axis k of `stride`, as bits
    !> (bit j - 1: component j), with the noise guard: both differences above round-off and of opposite
-   !> sign. 0 if the cell or a neighbour is missing (a cell missing a neighbour cannot be tested [?]).
-   !> The components are tested without branches: in a flow that has just been set in motion half the
-   !> cells oscillate, at random, and a branch per test was mispredicted half the time (measured on the
-   !> collapsing water column). Cells without the material are not read (their values are anything).
+   !> sign (3-D; in 2-D row_flags_in_lanes). 0 if the cell or a neighbour is missing (a cell missing a
+   !> neighbour cannot be tested [?]). The components are tested without branches: in a flow that has
+   !> just been set in motion half the cells oscillate, at random, and a branch per test was mispredicted
+   !> half the time (measured on the collapsing water column). Cells without the material are not read
+   !> (their values are anything).
    !> Also the eq. 7 slope along k of every existing cell of the row: central with both neighbours,
    !> one-sided with one, else 0. Most faces of a flow in motion are active, and a cell's slope serves
    !> both of its faces: once per cell here rather than twice per face.
@@ -290,16 +319,81 @@ contains
       end do
    end subroutine row_oscillation_bits
 
+   !> The cells first..first + count - 1 of a row (2-D) one array per quantity, (n, nq + 3): q_c (nq),
+   !> x_o^c (2), the flag (1 or 0); and their round-off scale (see noise_guard; max, not maxval: no NaN
+   !> tests). row_flags_in_lanes computes with every cell of a row and its neighbours and drops what a
+   !> missing cell gave, so a missing cell's values are 0 here (its field entry may hold anything).
+   subroutine row_columns(nq, n, exists, field, first, count, columns, scale)
+      integer, intent(in) :: nq, n, first, count
+      logical, intent(in) :: exists(*)
+      real(rp), intent(in) :: field(4 + nq, *)
+      real(rp), intent(inout) :: columns(n, nq + 3), scale(*)
+      integer :: c, j
+      real(rp) :: largest
+      do c = first, first + count - 1
+         do j = 1, nq
+            columns(c, j) = merge(field(4 + j, c), 0.0_rp, exists(c))
+         end do
+         columns(c, nq + 1) = merge(field(3, c), 0.0_rp, exists(c))
+         columns(c, nq + 2) = merge(field(4, c), 0.0_rp, exists(c))
+         columns(c, nq + 3) = merge(1.0_rp, 0.0_rp, exists(c))
+      end do
+      do c = first, first + count - 1
+         largest = abs(columns(c, 1))
+         do j = 2, nq
+            largest = max(largest, abs(columns(c, j)))
+         end do
+         scale(c) = noise_guard * largest
+      end do
+   end subroutine row_columns
+
+   !> row_oscillation_bits in vector lanes (2-D), from the cells' values one array per quantity: q(:, j),
+   !> the centres along the axis x, the flags `present` (1 or 0). Every cell of the row is computed, its
+   !> neighbours selected by products with the flags rather than by branches or merge (which gcc 12 does
+   !> not vectorise here), and what a missing cell gave is dropped. With finite values a product by 1 or 0
+   !> and a sum with a zero are exact, so the flags and slopes are those of row_oscillation_bits (a zero's
+   !> sign aside). A missing cell's slope is not read.
+   subroutine row_flags_in_lanes(nq, n, present, scale, q, x, first, count, stride, d_min, oscillating, slope)
+      integer, intent(in) :: nq, n, first, count, stride
+      real(rp), intent(in) :: present(n), scale(n), q(n, nq), x(n), d_min
+      integer, intent(inout) :: oscillating(n)
+      real(rp), intent(inout) :: slope(n, nq)
+      real(rp) :: noise, left, right, distance, lower, upper, below, above, opposite
+      integer :: j, c, bits
+      do c = first, first + count - 1
+         below = present(c - stride)
+         above = present(c + stride)
+         noise = max(scale(c - stride), scale(c), scale(c + stride))
+         bits = 0
+         do j = 1, nq
+            left = q(c, j) - q(c - stride, j)
+            right = q(c + stride, j) - q(c, j)
+            opposite = merge(1.0_rp, 0.0_rp, min(abs(right), abs(left)) > noise) * &
+                       merge(1.0_rp, 0.0_rp, right * left < 0.0_rp)
+            bits = bits + int(opposite) * 2**(j - 1)
+         end do
+         oscillating(c) = int(present(c) * below * above) * bits
+         lower = below * x(c - stride) + (1.0_rp - below) * x(c)
+         upper = above * x(c + stride) + (1.0_rp - above) * x(c)
+         distance = max(upper - lower, d_min)
+         do j = 1, nq
+            lower = below * q(c - stride, j) + (1.0_rp - below) * q(c, j)
+            upper = above * q(c + stride, j) + (1.0_rp - above) * q(c, j)
+            slope(c, j) = max(below, above) * ((upper - lower) / distance)
+         end do
+      end do
+   end subroutine row_flags_in_lanes
+
    !> The limited flux across the face (c, c + stride of axis k), if both cells exist, at least one is
    !> owned, and the face is active for some component; added to dq of the owned side(s).
    !> One division per face: 1 / (m_- + m_+) serves x_m (eq. 8) and every value's flux (eq. 11), which
    !> the general code below divides by one at a time (a division per value on the store's critical path;
    !> the results differ by round-off, docs/performance.md "FOAL1's face flux with one division").
-   subroutine face_flux(dim, nq, box, exists, field, options, oscillating, slope, c, k, dq)
-      integer, intent(in) :: dim, nq
+   subroutine face_flux(dim, nq, box, exists, field, options, oscillating, slope, cell_step, value_step, c, k, dq)
+      integer, intent(in) :: dim, nq, cell_step, value_step
       type(padded_cells_t), intent(in) :: box
       logical, intent(in) :: exists(*)
-      real(rp), intent(in) :: field(2 + dim + nq, *), slope(nq, *)
+      real(rp), intent(in) :: field(2 + dim + nq, *), slope(*)
       type(flux_options_t), intent(in) :: options
       integer, intent(in) :: oscillating(*), c, k
       real(rp), intent(inout) :: dq(nq, *)
@@ -327,7 +421,8 @@ contains
          do j = 1, nq
             if (.not. btest(active, j - 1)) cycle
             jump = field(2 + dim + j, c) - field(2 + dim + j, right)
-            allowed = (x_m - x_minus) * slope(j, c) - (x_m - x_plus) * slope(j, right)   ! e_- - e_+
+            allowed = (x_m - x_minus) * slope(1 + (c - 1) * cell_step + (j - 1) * value_step) &
+                      - (x_m - x_plus) * slope(1 + (right - 1) * cell_step + (j - 1) * value_step)   ! e_- - e_+
             limited_jump = sign0(jump) * min(max(sign0(jump) * (jump + allowed), 0.0_rp), abs(jump))  ! eq. 12
             flux = flux_per_jump * limited_jump
             if (owned_plus) dq(j, right) = dq(j, right) + m_minus * flux
