@@ -348,21 +348,21 @@ contains
    end subroutine row_columns
 
    !> row_oscillation_bits in vector lanes (2-D), from the cells' values one array per quantity: q(:, j),
-   !> the centres along the axis x, the flags `present` (1 or 0). Every cell of the row is computed, its
-   !> neighbours selected by products with the flags rather than by branches or merge (which gcc 12 does
-   !> not vectorise here), and what a missing cell gave is dropped. With finite values a product by 1 or 0
-   !> and a sum with a zero are exact, so the flags and slopes are those of row_oscillation_bits (a zero's
-   !> sign aside). A missing cell's slope is not read.
-   subroutine row_flags_in_lanes(nq, n, present, scale, q, x, first, count, stride, d_min, oscillating, slope)
+   !> the centres along the axis x, and `flag`, 1 where the cell holds the material and else 0. Every cell
+   !> of the row is computed, its neighbours selected by products with the flags rather than by branches or
+   !> merge (which gcc 12 does not vectorise here), and what a missing cell gave is dropped. With finite
+   !> values a product by 1 or 0 and a sum with a zero are exact, so the flags and slopes are those of
+   !> row_oscillation_bits (a zero's sign aside). A missing cell's slope is not read.
+   subroutine row_flags_in_lanes(nq, n, flag, scale, q, x, first, count, stride, d_min, oscillating, slope)
       integer, intent(in) :: nq, n, first, count, stride
-      real(rp), intent(in) :: present(n), scale(n), q(n, nq), x(n), d_min
+      real(rp), intent(in) :: flag(n), scale(n), q(n, nq), x(n), d_min
       integer, intent(inout) :: oscillating(n)
       real(rp), intent(inout) :: slope(n, nq)
       real(rp) :: noise, left, right, distance, lower, upper, below, above, opposite
       integer :: j, c, bits
       do c = first, first + count - 1
-         below = present(c - stride)
-         above = present(c + stride)
+         below = flag(c - stride)
+         above = flag(c + stride)
          noise = max(scale(c - stride), scale(c), scale(c + stride))
          bits = 0
          do j = 1, nq
@@ -372,7 +372,7 @@ contains
                        merge(1.0_rp, 0.0_rp, right * left < 0.0_rp)
             bits = bits + int(opposite) * 2**(j - 1)
          end do
-         oscillating(c) = int(present(c) * below * above) * bits
+         oscillating(c) = int(flag(c) * below * above) * bits
          lower = below * x(c - stride) + (1.0_rp - below) * x(c)
          upper = above * x(c + stride) + (1.0_rp - above) * x(c)
          distance = max(upper - lower, d_min)
