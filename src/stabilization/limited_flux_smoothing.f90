@@ -124,12 +124,9 @@ contains
       integer, intent(inout) :: oscillating(*)
       real(rp), intent(inout) :: scale(*), slope(*), columns(box%count, merge(nq + 3, 0, dim == 2)), &
                                  dq(nq, *)
-      integer :: k, c, stride, i1, i2, i3, flo(3), fhi(3), j, cell_step, value_step
-      real(rp) :: d_min, largest
+      integer :: k, c, stride, i1, i2, i3, flo(3), fhi(3)
+      real(rp) :: d_min
       d_min = min_centre_distance * h
-      ! slope of value j of cell c: slope(1 + (c - 1) cell_step + (j - 1) value_step)
-      cell_step = merge(1, nq, dim == 2)
-      value_step = merge(box%count, 1, dim == 2)
       if (dim == 2) then
          ! lo:hi and the cells around it, which the rows read as neighbours (their flags 0)
          flo(1:2) = max(lo(1:2) - 1, 1)
@@ -143,13 +140,7 @@ contains
             do i2 = lo(2), hi(2)
                c = flat_index(box, lo(1), i2, i3)
                do i1 = lo(1), hi(1)
-                  if (exists(c)) then     ! round-off scale (see noise_guard); max, not maxval: no NaN tests
-                     largest = abs(field(3 + dim, c))
-                     do j = 2, nq
-                        largest = max(largest, abs(field(2 + dim + j, c)))
-                     end do
-                     scale(c) = noise_guard * largest
-                  end if
+                  if (exists(c)) scale(c) = round_off_scale(nq, field(3 + dim:2 + dim + nq, c))
                   c = c + 1
                end do
             end do
@@ -183,8 +174,7 @@ contains
                c = flat_index(box, flo(1), i2, i3)
                do i1 = flo(1), fhi(1)
                   if (ior(oscillating(c), oscillating(c + stride)) /= 0) &
-                     call face_flux(dim, nq, box, exists, field, options, oscillating, slope, cell_step, value_step, c, k, &
-                                    dq)
+                     call face_flux(dim, nq, box, exists, field, options, oscillating, slope, c, k, dq)
                   c = c + 1
                end do
             end do
@@ -320,16 +310,15 @@ contains
    end subroutine row_oscillation_bits
 
    !> The cells first..first + count - 1 of a row (2-D) one array per quantity, (n, nq + 3): q_c (nq),
-   !> x_o^c (2), the flag (1 or 0); and their round-off scale (see noise_guard; max, not maxval: no NaN
-   !> tests). row_flags_in_lanes computes with every cell of a row and its neighbours and drops what a
-   !> missing cell gave, so a missing cell's values are 0 here (its field entry may hold anything).
+   !> x_o^c (2), the flag (1 or 0); and their round-off scale. row_flags_in_lanes computes with every cell
+   !> of a row and its neighbours and drops what a missing cell gave, so a missing cell's values are 0
+   !> here (its field entry may hold anything).
    subroutine row_columns(nq, n, exists, field, first, count, columns, scale)
       integer, intent(in) :: nq, n, first, count
       logical, intent(in) :: exists(*)
       real(rp), intent(in) :: field(4 + nq, *)
       real(rp), intent(inout) :: columns(n, nq + 3), scale(*)
       integer :: c, j
-      real(rp) :: largest
       do c = first, first + count - 1
          do j = 1, nq
             columns(c, j) = merge(field(4 + j, c), 0.0_rp, exists(c))
@@ -339,13 +328,22 @@ contains
          columns(c, nq + 3) = merge(1.0_rp, 0.0_rp, exists(c))
       end do
       do c = first, first + count - 1
-         largest = abs(columns(c, 1))
-         do j = 2, nq
-            largest = max(largest, abs(columns(c, j)))
-         end do
-         scale(c) = noise_guard * largest
+         scale(c) = round_off_scale(nq, columns(c, 1:nq))
       end do
    end subroutine row_columns
+
+   !> A cell's round-off scale (see noise_guard) from its values q_c; max, not maxval: no NaN tests.
+   pure real(rp) function round_off_scale(nq, q)
+      integer, intent(in) :: nq
+      real(rp), intent(in) :: q(nq)
+      real(rp) :: largest
+      integer :: j
+      largest = abs(q(1))
+      do j = 2, nq
+         largest = max(largest, abs(q(j)))
+      end do
+      round_off_scale = noise_guard * largest
+   end function round_off_scale
 
    !> row_oscillation_bits in vector lanes (2-D), from the cells' values one array per quantity: q(:, j),
    !> the centres along the axis x, and `flag`, 1 where the cell holds the material and else 0. Every cell
@@ -389,17 +387,20 @@ contains
    !> One division per face: 1 / (m_- + m_+) serves x_m (eq. 8) and every value's flux (eq. 11), which
    !> the general code below divides by one at a time (a division per value on the store's critical path;
    !> the results differ by round-off, docs/performance.md "FOAL1's face flux with one division").
-   subroutine face_flux(dim, nq, box, exists, field, options, oscillating, slope, cell_step, value_step, c, k, dq)
-      integer, intent(in) :: dim, nq, cell_step, value_step
+   subroutine face_flux(dim, nq, box, exists, field, options, oscillating, slope, c, k, dq)
+      integer, intent(in) :: dim, nq
       type(padded_cells_t), intent(in) :: box
       logical, intent(in) :: exists(*)
       real(rp), intent(in) :: field(2 + dim + nq, *), slope(*)
       type(flux_options_t), intent(in) :: options
       integer, intent(in) :: oscillating(*), c, k
       real(rp), intent(inout) :: dq(nq, *)
-      integer :: j, right, active
+      integer :: j, right, active, cell_step, value_step
       real(rp) :: n_faces, flux, jump, limited_jump, x_m, allowed, inv_mass, flux_per_jump
       logical :: owned_minus, owned_plus
+      ! slope of value j of cell c: slope(1 + (c - 1) cell_step + (j - 1) value_step) (layouts: flux_increments)
+      cell_step = merge(1, nq, dim == 2)
+      value_step = merge(box%count, 1, dim == 2)
       right = c + box%stride(k)
       if (.not. (exists(c) .and. exists(right))) return
       owned_minus = box%owned(c)
