@@ -8,7 +8,7 @@
 !> 15 % of them (as later, and in the tank). The field is the same from run to run (a fixed seed), so the
 !> checksum compares two builds' increments; the time is the best of `rounds` (default 30) rounds of 20
 !> calls. A whole run's step time moves by 5-10 % on a shared machine; the kernel alone, alternating two
-!> binaries over a dozen processes, moves by a few per cent (docs/performance.md, "FOAL1's flags and
+!> binaries over a dozen processes, moves by a few per cent (docs/performance-history.md, "FOAL1's flags and
 !> slopes in vector lanes").
 program flotsam_flux_bench
    use, intrinsic :: iso_fortran_env, only: error_unit, int64

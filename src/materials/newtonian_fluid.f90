@@ -59,7 +59,7 @@ contains
    !> fluid_point_update for every particle, bit for bit, with its components written out (2-D: xx, yy,
    !> zz, xy; 3-D: xx, yy, zz, yz, xz, xy): a loop over the particles without inner loops, which the
    !> compiler vectorises (five divisions per particle; the per-particle calls were 17 % of a 2-D step's
-   !> time, docs/performance.md).
+   !> time, docs/performance-history.md, "Vectorised passes outside the transfers").
    pure subroutine viscous_update(bulk_modulus, viscosity, dim, dt, d, density, sbar)
       real(rp), intent(in) :: bulk_modulus, viscosity, dt
       real(rp), intent(in), contiguous :: d(:, :)

@@ -6,7 +6,7 @@
 !> Gbar_i needs only the cell's mean position in the cell (2-D: from its mass centre x_o^c, the "2D identity")
 !> and, in 3-D, also the means of the products of two coordinates (cell_binning's local moments): exact, not
 !> an approximation. Per cell instead of per particle, and G2P need not form the particles' velocity
-!> gradients at all: a C0 step without its most expensive per-particle work (docs/performance.md, "C0's
+!> gradients at all: a C0 step without its most expensive per-particle work (docs/performance-history.md, "C0's
 !> rate from the grid"). The sums differ from the particle average's in round-off only.
 module cell_strain_rate
    use kinds, only: rp

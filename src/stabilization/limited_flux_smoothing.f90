@@ -386,7 +386,7 @@ contains
    !> owned, and the face is active for some component; added to dq of the owned side(s).
    !> One division per face: 1 / (m_- + m_+) serves x_m (eq. 8) and every value's flux (eq. 11), which
    !> the general code below divides by one at a time (a division per value on the store's critical path;
-   !> the results differ by round-off, docs/performance.md "FOAL1's face flux with one division").
+   !> the results differ by round-off, docs/performance-history.md "FOAL1's face flux with one division").
    subroutine face_flux(dim, nq, box, exists, field, options, oscillating, slope, c, k, dq)
       integer, intent(in) :: dim, nq
       type(padded_cells_t), intent(in) :: box

@@ -7,7 +7,7 @@
 !> the grid's shape functions, multilinear or quadratic B-spline (the projection onto the nodes is the same
 !> lumped L2 projection whatever the stencil; docs/theory.md section 1.1).
 !>
-!> Cost (docs/performance.md, "NB"): the particle loops are node_based_kernels' compile-time instances;
+!> Cost (docs/performance-history.md, "NB"): the particle loops are node_based_kernels' compile-time instances;
 !> the work arrays are kept from step to step (they only grow); and when the material's particles are
 !> all the particles (context%sole_material) m_i is the grid's mass row of the step's P2G, the same sum
 !> in the same order, so `prepare` neither sums nor exchanges the masses again.

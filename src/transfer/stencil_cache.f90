@@ -1,7 +1,7 @@
 !> Where each particle's stencil lies at x^n, kept from P2G for the other passes of the same step that
 !> visit the particles' stencils: the re-map and G2P (src/transfer/grid_transfer.F90) and NB's shape values
 !> (src/stabilization/node_based_anti_locking.f90). They read the base node and the position in cells from
-!> here instead of locating each particle again, which was a sixth of a 3-D step (docs/performance.md,
+!> here instead of locating each particle again, which was a sixth of a 3-D step (docs/performance-history.md,
 !> "Stencils located once per step"). Only the 3-D kernels keep them (28 bytes per particle).
 !>
 !> Valid while the particles neither move nor change order: the solver gives it to P2G, which fills it, and
