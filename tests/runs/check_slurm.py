@@ -17,7 +17,7 @@ import stat
 import subprocess
 import sys
 
-from flotsam_run import MPI_ENVIRONMENT, Checks, main_arguments, read_diagnostics, wait_for_rows
+from flotsam_run import MPI_ENVIRONMENT, Checks, DrainedPopen, main_arguments, read_diagnostics, wait_for_rows
 
 FAKE_SRUN = """#!/bin/bash
 # srun stand-in: drop srun's options, start the tasks with the MPI launcher (exec: same pid, so a
@@ -73,8 +73,8 @@ def main():
                            SLURM_NTASKS="2", SLURM_SUBMIT_DIR=work, FLOTSAM=flotsam_path, **variables)
         if os.path.exists(sbatch_log):
             os.remove(sbatch_log)
-        return subprocess.Popen(["bash", os.path.join(slurm, script)] + arguments, env=environment, cwd=work,
-                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        return DrainedPopen(["bash", os.path.join(slurm, script)] + arguments, env=environment, cwd=work,
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
 
     def submitted():
         if not os.path.exists(sbatch_log):

@@ -24,7 +24,7 @@ import signal
 import subprocess
 import sys
 
-from flotsam_run import Checks, child_pids, main_arguments, read_diagnostics, wait_for_rows
+from flotsam_run import Checks, DrainedPopen, child_pids, main_arguments, read_diagnostics, wait_for_rows
 
 
 def ended(line):
@@ -194,8 +194,8 @@ def main():
                  "--mpiexec", mpiexec]
     folders = [os.path.join(long_out, "cases", f"stabilization-{s}_max_steps-{steps}") for s in ("C0", "NB")]
     for number, how in ((1, "ranks"), (2, "study")):
-        process = subprocess.Popen(long_base + ["--case", str(number)], stdout=subprocess.PIPE,
-                                   stderr=subprocess.PIPE, text=True)
+        process = DrainedPopen(long_base + ["--case", str(number)], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
         started = wait_for_rows(os.path.join(folders[number - 1], "diagnostics.csv"), process)
         if how == "ranks":         # a batch system's SIGTERM to the job's processes
             for pid in ranks_of(process, flotsam_path):

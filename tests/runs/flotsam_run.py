@@ -9,6 +9,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 
 MPI_ENVIRONMENT = {
@@ -19,6 +20,39 @@ MPI_ENVIRONMENT = {
     "OMPI_MCA_io": "romio321",
 }
 
+
+class DrainedPopen(subprocess.Popen):
+    """subprocess.Popen whose stdout and stderr pipes are read by threads from the start. A test that waits
+    for a file or for diagnostics rows while the run goes on reads none of its output meanwhile; with a
+    plain pipe, a run that prints more than the pipe holds (64 kB on Linux: progress lines of a slow debug
+    build on a loaded machine) blocks in its write, and the test waits for rows that never come.
+    communicate() returns what was read, as Popen's does."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._read = {}
+        self._readers = []
+        for name in ("stdout", "stderr"):
+            stream = getattr(self, name)
+            if stream is None:
+                continue
+            chunks = self._read[name] = []
+            # read() returns at the end of the stream: when the run and its children have closed it
+            reader = threading.Thread(target=lambda stream=stream, chunks=chunks: chunks.append(stream.read()),
+                                      daemon=True)
+            reader.start()
+            self._readers.append(reader)
+
+    def communicate(self, input=None, timeout=None):
+        if input is not None:
+            raise ValueError("DrainedPopen takes no input")
+        self.wait(timeout=timeout)
+        for reader in self._readers:
+            reader.join()
+        for name in self._read:
+            getattr(self, name).close()
+        empty = "" if self.text_mode else b""
+        return tuple(empty.join(self._read[name]) if name in self._read else None for name in ("stdout", "stderr"))
 
 
 class Checks:
@@ -83,8 +117,8 @@ class Flotsam:
 
     def start(self, scene, ranks, *arguments):
         """Start a run in the background."""
-        return subprocess.Popen(self.command(scene, ranks, *arguments), cwd=self.workdir, env=self.environment,
-                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        return DrainedPopen(self.command(scene, ranks, *arguments), cwd=self.workdir, env=self.environment,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
     def path(self, *parts):
         return os.path.join(self.workdir, *parts)
@@ -235,5 +269,5 @@ def main_arguments():
     return sys.argv[1], sys.argv[2], os.path.abspath(sys.argv[3]), sys.argv[4:]
 
 
-__all__ = ["Checks", "Flotsam", "PrivateDisplay", "checkpoint_at_step", "child_pids", "rank_pids", "wait_for_file", "wait_for_rows",
+__all__ = ["Checks", "DrainedPopen", "Flotsam", "PrivateDisplay", "checkpoint_at_step", "child_pids", "rank_pids", "wait_for_file", "wait_for_rows",
            "signal_ranks", "read_diagnostics", "csv_data_lines", "signal", "main_arguments"]
