@@ -330,8 +330,10 @@ contains
       end do
       ! round_off_scale's maximum written out: a cell's values lie a column apart here, which that function's
       ! explicit-shape dummy takes through a temporary copy at every call (a debug build warns at each one:
-      ! millions of lines per run), and an assumed-shape dummy made the flux stage slower (flotsam_flux_bench
-      ! dense 641-911 against 624-637 us); written out, the loop runs across the cells in vector lanes
+      ! millions of lines per run). Two ways of calling it measured slower on flotsam_flux_bench's dense
+      ! field: an assumed-shape dummy (641-911 against 624-637 us) and the call on the packed field's
+      ! contiguous values behind a test of `exists` (684-696 against 663-684 us); written out, the loop runs
+      ! across the cells in vector lanes
       do c = first, first + count - 1
          largest = abs(columns(c, 1))
          do j = 2, nq
