@@ -36,6 +36,25 @@ if(FLOTSAM_USE_PFUNIT)
   endif()
 endif()
 
+# A Debug build (-fcheck=all) prints this line for each array gfortran copies to pass it to a procedure
+# (docs/conventions.md: gfortran 12 copies at every call, also in a Release build): every test of a folder
+# fails on it, its exit code apart. Called by flotsam_add_test_suite for its tests, and at the end of the
+# folders that add tests of their own (a test's properties can only be set in its folder).
+set(FLOTSAM_ARRAY_COPY_MESSAGE "An array temporary was created")
+function(flotsam_fail_on_array_copies)
+  get_property(folder_tests DIRECTORY PROPERTY TESTS)
+  foreach(test IN LISTS folder_tests)
+    get_test_property(${test} FAIL_REGULAR_EXPRESSION patterns)
+    if(NOT patterns)
+      set(patterns "")
+    endif()
+    if(NOT FLOTSAM_ARRAY_COPY_MESSAGE IN_LIST patterns)
+      list(APPEND patterns "${FLOTSAM_ARRAY_COPY_MESSAGE}")
+      set_tests_properties(${test} PROPERTIES FAIL_REGULAR_EXPRESSION "${patterns}")
+    endif()
+  endforeach()
+endfunction()
+
 # Fortran names: a letter, then letters, digits, underscores; 63 characters at most (F2018).
 # 60 for test procedures, to leave room for the pf_ prefix of the pFUnit wrappers.
 function(_flotsam_check_fortran_name what name max_length)
@@ -164,6 +183,8 @@ function(flotsam_add_test_suite)
       LABELS "${ARG_LABELS};serial"
       TIMEOUT ${ARG_TIMEOUT})
   endif()
+
+  flotsam_fail_on_array_copies()
 
   # --- optional: the same procedures as pFUnit tests --------------------------------------------
   get_property(have_pfunit GLOBAL PROPERTY FLOTSAM_HAVE_PFUNIT)

@@ -62,7 +62,7 @@ contains
       logical, intent(in) :: exists(:)
       real(rp), intent(in) :: mass(:), centre(:, :), q(:, :)
       type(flux_options_t), intent(in) :: options
-      real(rp), intent(inout) :: dq(:, :)
+      real(rp), contiguous, intent(inout) :: dq(:, :)      ! as field_flux_increments' (else gfortran copies it)
       type(flux_workspace_t), intent(inout) :: workspace
       real(rp), allocatable :: field(:, :)
       integer :: dim
@@ -455,7 +455,7 @@ contains
       logical, intent(in) :: exists(:)
       real(rp), intent(in) :: mass(:), centre(:, :), q(:, :)
       type(flux_options_t), intent(in) :: options
-      real(rp), intent(inout) :: dq(:, :)
+      real(rp), contiguous, intent(inout) :: dq(:, :)      ! as start_workspace's (else gfortran copies it)
       type(flux_workspace_t), intent(inout) :: workspace
       integer :: k, nq, c, stride, i1, i2, i3, lo(3), hi(3), flo(3), fhi(3)
 

@@ -31,7 +31,9 @@ contains
       integer, intent(in) :: first, last
       integer, intent(inout), contiguous :: base(:)
       real(rp), intent(inout), contiguous :: weight(:, :)
-      real(rp), intent(inout), optional, contiguous :: mass(:)
+      ! assumed size, not a contiguous assumed shape: the caller's row nodal_mass(1, :) is contiguous but not
+      ! known to be, and gfortran 12 copies such a section in and out of a contiguous dummy at every call
+      real(rp), intent(inout), optional :: mass(*)
       type(stencil_cache_t), intent(in), optional :: stencils
       select case (instance(grid))
       case (1); call store_2d(grid, particles, first, last, base, weight, mass)

@@ -21,6 +21,20 @@ MPI_ENVIRONMENT = {
 }
 
 
+# A Debug build's report of an array copy (cmake/FlotsamTesting.cmake): a run's report is passed on to the
+# test's own output, where CTest fails the test on it.
+ARRAY_COPY_MESSAGE = "An array temporary was created"
+
+
+def pass_on_array_copies(stderr):
+    """Write the lines of a run's stderr (text) that report an array copy, and the line before each (where),
+    to this test's stderr."""
+    lines = (stderr or "").splitlines()
+    for i, line in enumerate(lines):
+        if ARRAY_COPY_MESSAGE in line:
+            sys.stderr.write("flotsam run: " + (lines[i - 1] + " " if i > 0 else "") + line + "\n")
+
+
 class DrainedPopen(subprocess.Popen):
     """subprocess.Popen whose stdout and stderr pipes are read by threads from the start. A test that waits
     for a file or for diagnostics rows while the run goes on reads none of its output meanwhile; with a
@@ -52,7 +66,10 @@ class DrainedPopen(subprocess.Popen):
         for name in self._read:
             getattr(self, name).close()
         empty = "" if self.text_mode else b""
-        return tuple(empty.join(self._read[name]) if name in self._read else None for name in ("stdout", "stderr"))
+        output = tuple(empty.join(self._read[name]) if name in self._read else None for name in ("stdout", "stderr"))
+        if self.text_mode:
+            pass_on_array_copies(output[1])
+        return output
 
 
 class Checks:
@@ -112,8 +129,10 @@ class Flotsam:
 
     def run(self, scene, ranks, *arguments, timeout=600):
         """Run to completion; returns the CompletedProcess (returncode, stdout, stderr)."""
-        return subprocess.run(self.command(scene, ranks, *arguments), cwd=self.workdir, env=self.environment,
-                              capture_output=True, text=True, timeout=timeout)
+        result = subprocess.run(self.command(scene, ranks, *arguments), cwd=self.workdir, env=self.environment,
+                                capture_output=True, text=True, timeout=timeout)
+        pass_on_array_copies(result.stderr)
+        return result
 
     def start(self, scene, ranks, *arguments):
         """Start a run in the background."""

@@ -34,11 +34,13 @@ contains
    subroutine test_partition_of_unity()
       integer :: dim, i
       real(rp), allocatable :: xi(:, :)
-      real(rp) :: n(8), g(3, 8)
+      real(rp) :: n(8)
+      real(rp), allocatable :: g(:, :)  ! (dim, corners): a section of a 3-row array would be copied per call
       do dim = 2, 3
          xi = sample_points(dim)
+         g = spread(spread(0.0_rp, 1, dim), 2, 2**dim)
          do i = 1, size(xi, 2)
-            call shape_values_and_gradients(dim, xi(:, i), 1.0_rp / h, n(1:2**dim), g(1:dim, 1:2**dim))
+            call shape_values_and_gradients(dim, xi(:, i), 1.0_rp / h, n(1:2**dim), g)
             call assertEqual(1.0_rp, sum(n(1:2**dim)), 1.0e-14_rp, 'sum of N_a')
             call assertEqual(0.0_rp, min(0.0_rp, minval(n(1:2**dim))), 0.0_rp, 'N_a >= 0')
          end do
@@ -48,11 +50,13 @@ contains
    subroutine test_gradient_sum()
       integer :: dim, i, k
       real(rp), allocatable :: xi(:, :)
-      real(rp) :: n(8), g(3, 8)
+      real(rp) :: n(8)
+      real(rp), allocatable :: g(:, :)  ! (dim, corners): a section of a 3-row array would be copied per call
       do dim = 2, 3
          xi = sample_points(dim)
+         g = spread(spread(0.0_rp, 1, dim), 2, 2**dim)
          do i = 1, size(xi, 2)
-            call shape_values_and_gradients(dim, xi(:, i), 1.0_rp / h, n(1:2**dim), g(1:dim, 1:2**dim))
+            call shape_values_and_gradients(dim, xi(:, i), 1.0_rp / h, n(1:2**dim), g)
             do k = 1, dim
                call assertEqual(0.0_rp, sum(g(k, 1:2**dim)), 1.0e-12_rp, 'sum of dN_a/dx_k')
             end do
@@ -64,11 +68,13 @@ contains
    subroutine test_linear_reproduction()
       integer :: dim, i, a, k, l
       real(rp), allocatable :: xi(:, :)
-      real(rp) :: n(8), g(3, 8), x_node(3), x_interp(3), jac(3, 3)
+      real(rp) :: n(8), x_node(3), x_interp(3), jac(3, 3)
+      real(rp), allocatable :: g(:, :)  ! (dim, corners)
       do dim = 2, 3
          xi = sample_points(dim)
+         g = spread(spread(0.0_rp, 1, dim), 2, 2**dim)
          do i = 1, size(xi, 2)
-            call shape_values_and_gradients(dim, xi(:, i), 1.0_rp / h, n(1:2**dim), g(1:dim, 1:2**dim))
+            call shape_values_and_gradients(dim, xi(:, i), 1.0_rp / h, n(1:2**dim), g)
             x_interp = 0.0_rp
             jac = 0.0_rp
             do a = 1, n_corners(dim)
@@ -97,10 +103,12 @@ contains
       integer, parameter :: cells = 7, samples = 200
       real(rp), parameter :: origin = -0.3_rp
       integer :: dim, i, a, k, l, kind, base(3), nodes
-      real(rp) :: s(3), xi(3), x_p(3), x_node(3), x_interp(3), grad_sum(3), jac(3, 3), n(27), g(3, 27), r(3)
+      real(rp) :: s(3), xi(3), x_p(3), x_node(3), x_interp(3), grad_sum(3), jac(3, 3), n(27), r(3)
+      real(rp), allocatable :: g(:, :)  ! (dim, nodes)
       do kind = shape_linear, shape_bspline2
          do dim = 2, 3
             nodes = stencil_nodes(kind, dim)
+            g = spread(spread(0.0_rp, 1, dim), 2, nodes)
             do i = 1, samples
                call random_number(r)
                ! in the grid, with the two upper faces of the whole grid among the samples
@@ -113,7 +121,7 @@ contains
                   base(k) = stencil_base(kind, s(k), cells)
                   xi(k) = s(k) - base(k)
                end do
-               call stencil_values(kind, dim, xi(1:dim), 1.0_rp / h, n(1:nodes), g(1:dim, 1:nodes))
+               call stencil_values(kind, dim, xi(1:dim), 1.0_rp / h, n(1:nodes), g)
                call assertEqual(1.0_rp, sum(n(1:nodes)), 1.0e-14_rp, 'sum of N_a')
                call assertTrue(minval(n(1:nodes)) >= 0.0_rp, 'N_a >= 0')
                call assertTrue(all(base(1:dim) >= merge(-1, 0, kind == shape_bspline2)) .and. &
