@@ -520,25 +520,44 @@ contains
       !> raises no bin: the heights are those of every block's particles, bit for bit. A NaN makes no skip.
       logical function block_stays_below(dim, b, e) result(below)
          integer, intent(in) :: dim, b, e
-         real(rp) :: top_max, across_min(2), across_max(2), mass_max, density_min, half, margin, u
+         real(rp) :: top_max, across_min(2), across_max(2), mass_max, density_min, half, margin, u(3), a(3, 3)
          integer :: p, k, bin_first(2), bin_last(2)
          below = .true.
          if (e < b) return         ! no particle on this rank
+         ! the extremes in scalar reductions over the particles, the axes written out: the loop vectorises
+         ! (with a loop over the axes inside, it did not: 3.6 ns per particle)
+         a = 0.0_rp
+         a(1:dim, 1) = self%up(1:dim)
+         a(1:dim, 2:dim) = self%horizontal(1:dim, 1:dim - 1)
          top_max = -huge(1.0_rp)
          across_min = huge(1.0_rp)
          across_max = -huge(1.0_rp)
          mass_max = 0.0_rp
          density_min = huge(1.0_rp)
-         do p = b, e
-            top_max = max(top_max, dot_product(particles%x(1:dim, p), self%up(1:dim)))
-            do k = 1, dim - 1
-               u = dot_product(particles%x(1:dim, p), self%horizontal(1:dim, k))
-               across_min(k) = min(across_min(k), u)
-               across_max(k) = max(across_max(k), u)
+         if (dim == 2) then
+            do p = b, e
+               u(1) = particles%x(1, p) * a(1, 1) + particles%x(2, p) * a(2, 1)
+               u(2) = particles%x(1, p) * a(1, 2) + particles%x(2, p) * a(2, 2)
+               top_max = max(top_max, u(1))
+               across_min(1) = min(across_min(1), u(2))
+               across_max(1) = max(across_max(1), u(2))
+               mass_max = max(mass_max, particles%mass(p))
+               density_min = min(density_min, particles%density(p))
             end do
-            mass_max = max(mass_max, particles%mass(p))
-            density_min = min(density_min, particles%density(p))
-         end do
+         else
+            do p = b, e
+               do k = 1, 3
+                  u(k) = particles%x(1, p) * a(1, k) + particles%x(2, p) * a(2, k) + particles%x(3, p) * a(3, k)
+               end do
+               top_max = max(top_max, u(1))
+               across_min(1) = min(across_min(1), u(2))
+               across_max(1) = max(across_max(1), u(2))
+               across_min(2) = min(across_min(2), u(3))
+               across_max(2) = max(across_max(2), u(3))
+               mass_max = max(mass_max, particles%mass(p))
+               density_min = min(density_min, particles%density(p))
+            end do
+         end if
          margin = 1.0e-9_rp * self%bin_width + 1.0e-12_rp * max(abs(top_max), maxval(abs(across_min(1:dim - 1))), &
                                                                maxval(abs(across_max(1:dim - 1))))
          half = 0.5_rp * (mass_max / density_min)**(1.0_rp / dim) * (1.0_rp + 1.0e-12_rp) + margin
