@@ -16,7 +16,7 @@ import shlex
 import subprocess
 import time
 
-from flotsam_run import Checks, Flotsam, csv_data_lines, main_arguments, read_diagnostics
+from flotsam_run import Checks, Flotsam, csv_data_lines, main_arguments, pass_on_array_copies, read_diagnostics
 
 RANKS = 2
 
@@ -36,6 +36,7 @@ def run_per_rank(flotsam, scene, arguments, limit_kib=None, timeout=120):
     result = subprocess.run(command, cwd=flotsam.workdir, env=flotsam.environment, capture_output=True, text=True,
                             timeout=timeout)
     seconds = time.monotonic() - start
+    pass_on_array_copies(result.stderr)
     codes = [int(line.split()[-1]) for line in result.stderr.splitlines() if line.startswith("rank exit status")]
     return result, codes, seconds
 

@@ -14,7 +14,7 @@ import shutil
 import subprocess
 import sys
 
-from flotsam_run import MPI_ENVIRONMENT, Checks
+from flotsam_run import MPI_ENVIRONMENT, Checks, pass_on_array_copies
 
 
 def main():
@@ -50,6 +50,7 @@ def main():
     scene = os.path.join(prefix, "share", "flotsam", "inputs", "hydrostatic_tank.nml")
     run = subprocess.run([mpiexec, "-n", "2", flotsam, scene, "--set", "&run max_steps = 10, output_dir = 'run' /"],
                          cwd=elsewhere, env=environment, capture_output=True, text=True)
+    pass_on_array_copies(run.stderr)
     summary = os.path.join(elsewhere, "run", "run_summary.csv")
     ok = run.returncode == 0 and os.path.exists(summary)
     if ok:
