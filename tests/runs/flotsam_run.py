@@ -289,4 +289,4 @@ def main_arguments():
 
 
 __all__ = ["Checks", "DrainedPopen", "Flotsam", "PrivateDisplay", "checkpoint_at_step", "child_pids", "rank_pids", "wait_for_file", "wait_for_rows",
-           "signal_ranks", "read_diagnostics", "csv_data_lines", "signal", "main_arguments"]
+           "signal_ranks", "read_diagnostics", "csv_data_lines", "signal", "main_arguments", "pass_on_array_copies"]

@@ -31,14 +31,22 @@ contains
       xi(1, 3) = 0.0_rp
    end function sample_points
 
+   !> A zero (dim, nodes) array for the gradients, passed whole so that the shape functions get it without a
+   !> copy (a section of a larger array was copied at every call: a Debug build's run-time warning).
+   pure function gradient_array(dim, nodes) result(g)
+      integer, intent(in) :: dim, nodes
+      real(rp), allocatable :: g(:, :)
+      allocate (g(dim, nodes), source=0.0_rp)
+   end function gradient_array
+
    subroutine test_partition_of_unity()
       integer :: dim, i
       real(rp), allocatable :: xi(:, :)
       real(rp) :: n(8)
-      real(rp), allocatable :: g(:, :)  ! (dim, corners): a section of a 3-row array would be copied per call
+      real(rp), allocatable :: g(:, :)  ! (dim, corners)
       do dim = 2, 3
          xi = sample_points(dim)
-         g = spread(spread(0.0_rp, 1, dim), 2, 2**dim)
+         g = gradient_array(dim, 2**dim)
          do i = 1, size(xi, 2)
             call shape_values_and_gradients(dim, xi(:, i), 1.0_rp / h, n(1:2**dim), g)
             call assertEqual(1.0_rp, sum(n(1:2**dim)), 1.0e-14_rp, 'sum of N_a')
@@ -51,10 +59,10 @@ contains
       integer :: dim, i, k
       real(rp), allocatable :: xi(:, :)
       real(rp) :: n(8)
-      real(rp), allocatable :: g(:, :)  ! (dim, corners): a section of a 3-row array would be copied per call
+      real(rp), allocatable :: g(:, :)  ! (dim, corners)
       do dim = 2, 3
          xi = sample_points(dim)
-         g = spread(spread(0.0_rp, 1, dim), 2, 2**dim)
+         g = gradient_array(dim, 2**dim)
          do i = 1, size(xi, 2)
             call shape_values_and_gradients(dim, xi(:, i), 1.0_rp / h, n(1:2**dim), g)
             do k = 1, dim
@@ -72,7 +80,7 @@ contains
       real(rp), allocatable :: g(:, :)  ! (dim, corners)
       do dim = 2, 3
          xi = sample_points(dim)
-         g = spread(spread(0.0_rp, 1, dim), 2, 2**dim)
+         g = gradient_array(dim, 2**dim)
          do i = 1, size(xi, 2)
             call shape_values_and_gradients(dim, xi(:, i), 1.0_rp / h, n(1:2**dim), g)
             x_interp = 0.0_rp
@@ -108,7 +116,7 @@ contains
       do kind = shape_linear, shape_bspline2
          do dim = 2, 3
             nodes = stencil_nodes(kind, dim)
-            g = spread(spread(0.0_rp, 1, dim), 2, nodes)
+            g = gradient_array(dim, nodes)
             do i = 1, samples
                call random_number(r)
                ! in the grid, with the two upper faces of the whole grid among the samples
