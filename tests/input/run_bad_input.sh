@@ -23,6 +23,11 @@ nranks=2
 time_limit=120
 
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+# When a rank exits with a non-zero code, Open MPI's mpirun ends the job by signalling the ranks, and waits
+# its SIGKILL timeout (1 s) twice even when all of them have exited: 2.5 s instead of 0.6 s per case here.
+# Every rank of these cases stops on its own before anything is written, so not waiting changes nothing
+# the cases check (a rank left behind was ended by mpirun before as well).
+export OMPI_MCA_odls_base_sigkill_timeout=0
 
 if [[ ! -x $flotsam ]]; then
    echo "no flotsam executable at $1" >&2
