@@ -29,8 +29,8 @@
 !>                   rho = rho_0 exp(p/K), so that the hydrostatic state is an EOS state.
 !>
 !> The occupancy uses the particles of all materials (a solid also fills space), at x^n: the volumes are
-!> equalised and the surface measured before the step's particle-to-grid transfer (prepare), the occupancy
-!> and the shifts follow it (measure_excess), reading its stencils (3-D). The shifts are added after the
+!> equalised before the step's particle-to-grid transfer (prepare); the occupancy, the surface and the shifts
+!> follow it (measure_excess), reading its stencils (3-D). The shifts are capped and added after the
 !> position update, so the wall safeguard and the migration of the step see them. Costs nothing without a
 !> fluid that selects it.
 module volume_correction
@@ -40,7 +40,7 @@ module volume_correction
    use scene_description, only: scene_t, shifts_particles, relaxes_to_eos
    use domain_decomposition, only: domain_t
    use background_grid, only: grid_t
-   use grid_transfer, only: volume_to_grid, gradient_at_particles
+   use grid_transfer, only: volume_to_grid, gradient_at_particles, extremes_block, extremes_rows
    use stencil_cache, only: stencil_cache_t
    use node_halo, only: sum_shared_nodes
    use particle_set, only: particle_set_t
@@ -100,7 +100,9 @@ module volume_correction
       real(rp) :: bin_lo(2) = 0.0_rp, bin_width = 0.0_rp
       logical, allocatable :: wall_activity(:)      !< walls' activity V_i was measured with
       real(rp), allocatable :: excess(:, :)         !< (1, node): occupancy, then psi_i
-      real(rp), allocatable :: shift(:, :)          !< (dim, p): displacement added after the position update
+      real(rp), allocatable :: block_extremes(:, :) !< per block of the occupancy's transfer (grid_transfer)
+      real(rp), allocatable :: shift(:, :)          !< (dim, p): displacement added after the position update, uncapped
+      real(rp) :: longest_shift = 0.0_rp             !< the cap of a shift [m]
       !> shortcuts that give the same bits (a test compares them with the general way): where up is a grid axis
       !> the surface cut looks the height up once per column of sub-cells, takes the lowest height once per
       !> column of nodes and stops at the first row of sub-cells above the surface; the height function skips
@@ -142,6 +144,7 @@ contains
       self%shifting = any(self%shifting_coefficient > 0.0_rp)
       self%relaxing = any(self%relaxation_rate > 0.0_rp)
       self%surface_model = self%shifting .and. norm2(gravity) > 0.0_rp
+      self%longest_shift = max_shift_in_cells * scene%grid%cell_size
       if (self%surface_model) call horizontal_frame(self, scene%grid%dim)
       if (self%shifting) self%interval = max(1, floor(coefficient_per_application / maxval(self%shifting_coefficient) &
                                                        * (1.0_rp + 1.0e-12_rp)))
@@ -154,8 +157,8 @@ contains
    end subroutine corrector_reset_grid
 
    !> At x^n, before the step's particle-to-grid transfer, on the steps that shift (every interval-th step; by
-   !> the step number, so a restart keeps the rhythm): the open volumes where the walls changed, the cells'
-   !> volumes equalised and the height function of the free surface. Collective.
+   !> the step number, so a restart keeps the rhythm): the open volumes where the walls changed and the cells'
+   !> volumes equalised.
    subroutine corrector_prepare(self, domain, grid, walls, particles, step)
       class(volume_corrector_t), intent(inout) :: self
       type(domain_t), intent(in) :: domain
@@ -172,13 +175,13 @@ contains
          call measure_open_volumes(self, grid, walls)
       end if
       call equalize_cell_volumes(self, grid, particles)
-      if (self%surface_model) call measure_surface_heights(self, domain, grid, particles)
    end subroutine corrector_prepare
 
    !> After the step's particle-to-grid transfer, positions still x^n (the transfer does not read the
-   !> densities prepare equalised), on the steps that shift: the occupancy, psi_i and the particles' shifts.
-   !> Collective. `stencils` (3-D): the transfer's (src/transfer/stencil_cache.f90), which the occupancy and
-   !> the gradients read with the shortcuts instead of locating the particles again.
+   !> densities prepare equalised), on the steps that shift: the occupancy, the height function of the free
+   !> surface (whose skip of blocks below the surface reads the extremes the occupancy's transfer took), psi_i
+   !> and the particles' shifts. Collective. `stencils` (3-D): the transfer's (src/transfer/stencil_cache.f90),
+   !> which the occupancy and the gradients read with the shortcuts instead of locating the particles again.
    subroutine corrector_measure_excess(self, domain, grid, walls, particles, stencils)
       class(volume_corrector_t), intent(inout) :: self
       type(domain_t), intent(in) :: domain
@@ -198,10 +201,19 @@ contains
       end if
       if (.not. allocated(self%excess)) allocate (self%excess(1, grid%node_count))
       self%excess = 0.0_rp
-      call volume_to_grid(grid, particles, self%excess(1, :), kept)
+      if (allocated(self%block_extremes)) then
+         if (size(self%block_extremes, 2) < (particles%count - 1) / extremes_block + 1) deallocate (self%block_extremes)
+      end if
+      if (.not. allocated(self%block_extremes)) &
+         allocate (self%block_extremes(extremes_rows, (size(particles%x, 2) - 1) / extremes_block + 1))
+      ! the occupancy, and the extremes of each block of particles that the height function's skip reads
+      call volume_to_grid(grid, particles, self%excess(1, :), kept, self%block_extremes)
       call sum_shared_nodes(domain, grid, self%excess)
       self%fluid_volume = self%open_volume
-      if (self%surface_model) call cut_by_surface(self, grid, walls)
+      if (self%surface_model) then
+         call measure_surface_heights(self, domain, grid, particles)
+         call cut_by_surface(self, grid, walls)
+      end if
       threshold = min_open_fraction * grid%h**grid%dim
       do i = 1, grid%node_count
          if (self%fluid_volume(i) >= threshold) then
@@ -215,7 +227,8 @@ contains
       call shifts_of_particles(self, grid, particles, self%open_volume >= threshold, kept)
    end subroutine corrector_measure_excess
 
-   !> dx_p = -D h^2 sum_a grad N_a psi_a for the particles of shifting materials, at most 0.1 h long.
+   !> dx_p = -D k h^2 sum_a grad N_a psi_a (k = interval) for the particles of shifting materials (the factor
+   !> -D k h^2 applied per cell by the transfer); the cap at 0.1 h comes with the application (apply_shifts).
    !> A node mostly closed by walls has no reliable occupancy: it takes the particle's own excess (the
    !> N-weighted mean over the reliable corners), so a wall is neither a sink nor a source (zero normal
    !> gradient), where psi = 0 would pull particles onto it.
@@ -225,49 +238,19 @@ contains
       type(particle_set_t), intent(in) :: particles
       logical, intent(in) :: reliable(:)
       type(stencil_cache_t), intent(in), optional :: stencils
-      real(rp) :: scale, longest
       integer :: m
       if (allocated(self%shift)) then
          if (size(self%shift, 2) < particles%count) deallocate (self%shift)
       end if
       if (.not. allocated(self%shift)) allocate (self%shift(grid%dim, max(1, size(particles%x, 2))))
-      longest = max_shift_in_cells * grid%h
       do m = 1, size(self%shifting_coefficient)
          if (self%shifting_coefficient(m) <= 0.0_rp) cycle
          if (particles%material_last(m) < particles%material_first(m)) cycle
          call gradient_at_particles(grid, particles, particles%material_first(m), particles%material_last(m), &
-                                    self%excess(1, :), reliable, self%shift, stencils)
-         scale = -self%shifting_coefficient(m) * self%interval * grid%h**2
-         ! literal dimensions: the loops over the components unroll (with the run-time one, 0.5 % of a run)
-         if (grid%dim == 2) then
-            call scale_and_cap(2, scale, longest, self%shift(:, particles%material_first(m):particles%material_last(m)))
-         else
-            call scale_and_cap(3, scale, longest, self%shift(:, particles%material_first(m):particles%material_last(m)))
-         end if
+                                    self%excess(1, :), reliable, self%shift, stencils, &
+                                    factor=-self%shifting_coefficient(m) * self%interval * grid%h**2)
       end do
    end subroutine shifts_of_particles
-
-   !> shift := scale * shift, then at most `longest` long. The cap takes norm2 (scaled, a division per
-   !> component) only where the plain sum of squares does not show the shift clearly shorter (most particles
-   !> move far less than the cap); the sum in the order of sum(shift**2).
-   subroutine scale_and_cap(dim, scale, longest, shift)
-      integer, intent(in) :: dim
-      real(rp), intent(in) :: scale, longest
-      real(rp), intent(inout) :: shift(:, :)
-      real(rp), parameter :: clearly_shorter = 0.999_rp     ! squared length ratio: far above round-off
-      real(rp) :: length, squares
-      integer :: p, k
-      do p = 1, size(shift, 2)
-         squares = 0.0_rp
-         do k = 1, dim
-            shift(k, p) = scale * shift(k, p)
-            squares = squares + shift(k, p)**2
-         end do
-         if (squares < clearly_shorter * longest**2) cycle
-         length = norm2(shift(1:dim, p))
-         if (length > longest) shift(1:dim, p) = shift(1:dim, p) * (longest / length)
-      end do
-   end subroutine scale_and_cap
 
    !> After the position update of the step (particle order unchanged since prepare), for the particles
    !> first:last. A shifted particle takes the hydrostatic pressure of its new place, p := p + rho g . dx
@@ -292,17 +275,29 @@ contains
 
    contains
 
-      !> x_p += dx_p, and sbar = -p/rho on the normal components: d(sbar) = -dp/rho = -g . dx (the dot
-      !> product summed in the order of dot_product), for the particles lo..hi.
+      !> x_p += dx_p, dx_p at most longest_shift long, and sbar = -p/rho on the normal components: d(sbar) =
+      !> -dp/rho = -g . dx (the dot product summed in the order of dot_product), for the particles lo..hi.
+      !> The cap takes norm2 (scaled, a division per component) only where the plain sum of squares does not
+      !> show the shift clearly shorter (most particles move far less than the cap).
       subroutine shift_particles(dim, lo, hi)
          integer, intent(in) :: dim, lo, hi
-         real(rp) :: rise
+         real(rp), parameter :: clearly_shorter = 0.999_rp     ! squared length ratio: far above round-off
+         real(rp) :: rise, squares, length, shift(dim)
          integer :: p, k
          do p = lo, hi
+            squares = 0.0_rp
+            do k = 1, dim
+               shift(k) = self%shift(k, p)
+               squares = squares + shift(k)**2
+            end do
+            if (squares >= clearly_shorter * self%longest_shift**2) then
+               length = norm2(shift)
+               if (length > self%longest_shift) shift = shift * (self%longest_shift / length)
+            end if
             rise = 0.0_rp
             do k = 1, dim
-               particles%x(k, p) = particles%x(k, p) + self%shift(k, p)
-               rise = rise + self%gravity(k) * self%shift(k, p)
+               particles%x(k, p) = particles%x(k, p) + shift(k)
+               rise = rise + self%gravity(k) * shift(k)
             end do
             particles%sbar(1:3, p) = particles%sbar(1:3, p) - rise
          end do
@@ -407,7 +402,7 @@ contains
       type(domain_t), intent(in) :: domain
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(in) :: particles
-      integer, parameter :: block_size = 256
+      integer, parameter :: block_size = 4 * extremes_block   ! 256: whole blocks of the extremes
       integer :: dim, k, p, corner, n(2), first(2, block_size), last(2, block_size), i, j, b, e, covered(2, 2)
       real(rp) :: box_hi(3), x(3), u, lo(2), hi(2), top(block_size), third, width, width_mass, width_density, &
                   widths(block_size), block_top
@@ -513,51 +508,37 @@ contains
 
    contains
 
-      !> Whether particles b..e would raise no bin, judged from bounds of the block: the largest x . up and
-      !> the extremes of x . horizontal, and the widest particle l = (max m / min rho)^(1/dim). Each
-      !> particle's own top and bins (particle_reach) lie within these (rounding is monotone; the margin
-      !> covers a dot product the compiler fuses otherwise and the cube root), so a block the bound skips
-      !> raises no bin: the heights are those of every block's particles, bit for bit. A NaN makes no skip.
+      !> Whether particles b..e would raise no bin, judged from bounds of the block, from the extremes of its
+      !> blocks of the occupancy's transfer (block_extremes, which b..e cover exactly): the largest x . up
+      !> and the extremes of x . horizontal over the blocks' boxes, and the widest particle l = (max m /
+      !> min rho)^(1/dim). Each particle's own top and bins (particle_reach) lie within these (rounding is
+      !> monotone; the margin covers a dot product the compiler fuses otherwise and the cube root), so a
+      !> block the bound skips raises no bin: the heights are those of every block's particles, bit for bit.
+      !> A NaN makes no skip.
       logical function block_stays_below(dim, b, e) result(below)
          integer, intent(in) :: dim, b, e
-         real(rp) :: top_max, across_min(2), across_max(2), mass_max, density_min, half, margin, u(3), a(3, 3)
-         integer :: p, k, bin_first(2), bin_last(2)
+         real(rp) :: top_max, across_min(2), across_max(2), mass_max, density_min, half, margin, lo(3), hi(3)
+         integer :: j, k, bin_first(2), bin_last(2)
          below = .true.
          if (e < b) return         ! no particle on this rank
-         ! the extremes in scalar reductions over the particles, the axes written out: the loop vectorises
-         ! (with a loop over the axes inside, it did not: 3.6 ns per particle)
-         a = 0.0_rp
-         a(1:dim, 1) = self%up(1:dim)
-         a(1:dim, 2:dim) = self%horizontal(1:dim, 1:dim - 1)
-         top_max = -huge(1.0_rp)
-         across_min = huge(1.0_rp)
-         across_max = -huge(1.0_rp)
+         lo = huge(1.0_rp)
+         hi = -huge(1.0_rp)
          mass_max = 0.0_rp
          density_min = huge(1.0_rp)
-         if (dim == 2) then
-            do p = b, e
-               u(1) = particles%x(1, p) * a(1, 1) + particles%x(2, p) * a(2, 1)
-               u(2) = particles%x(1, p) * a(1, 2) + particles%x(2, p) * a(2, 2)
-               top_max = max(top_max, u(1))
-               across_min(1) = min(across_min(1), u(2))
-               across_max(1) = max(across_max(1), u(2))
-               mass_max = max(mass_max, particles%mass(p))
-               density_min = min(density_min, particles%density(p))
-            end do
-         else
-            do p = b, e
-               do k = 1, 3
-                  u(k) = particles%x(1, p) * a(1, k) + particles%x(2, p) * a(2, k) + particles%x(3, p) * a(3, k)
-               end do
-               top_max = max(top_max, u(1))
-               across_min(1) = min(across_min(1), u(2))
-               across_max(1) = max(across_max(1), u(2))
-               across_min(2) = min(across_min(2), u(3))
-               across_max(2) = max(across_max(2), u(3))
-               mass_max = max(mass_max, particles%mass(p))
-               density_min = min(density_min, particles%density(p))
-            end do
-         end if
+         do j = (b - 1) / extremes_block + 1, (e - 1) / extremes_block + 1
+            lo = min(lo, self%block_extremes(1:3, j))
+            hi = max(hi, self%block_extremes(4:6, j))
+            mass_max = max(mass_max, self%block_extremes(7, j))
+            density_min = min(density_min, self%block_extremes(8, j))
+         end do
+         ! the extremes of a linear function over the box lo:hi, at its corners
+         top_max = box_maximum(self%up(1:dim), lo, hi)
+         across_min = 0.0_rp
+         across_max = 0.0_rp
+         do k = 1, dim - 1
+            across_min(k) = -box_maximum(-self%horizontal(1:dim, k), lo, hi)
+            across_max(k) = box_maximum(self%horizontal(1:dim, k), lo, hi)
+         end do
          margin = 1.0e-9_rp * self%bin_width + 1.0e-12_rp * max(abs(top_max), maxval(abs(across_min(1:dim - 1))), &
                                                                maxval(abs(across_max(1:dim - 1))))
          half = 0.5_rp * (mass_max / density_min)**(1.0_rp / dim) * (1.0_rp + 1.0e-12_rp) + margin
@@ -573,6 +554,16 @@ contains
          end do
          below = top_max + half + margin <= lowest_height(self%surface_height, bin_first, bin_last)
       end function block_stays_below
+
+      !> The largest a . x over the box lo:hi (size(a) axes), at one of its corners.
+      pure real(rp) function box_maximum(a, lo, hi) result(largest)
+         real(rp), intent(in) :: a(:), lo(:), hi(:)
+         integer :: i
+         largest = 0.0_rp
+         do i = 1, size(a)
+            largest = largest + merge(a(i) * hi(i), a(i) * lo(i), a(i) >= 0.0_rp)
+         end do
+      end function box_maximum
 
       !> A particle of width `width` at x: its top x . up + width / 2 and the bins its width covers.
       pure subroutine particle_reach(dim, width, x, top, first, last)

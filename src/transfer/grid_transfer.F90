@@ -18,6 +18,11 @@ module grid_transfer
    public :: particles_to_grid, update_velocity_and_remap, grid_to_particles, volume_to_grid, gradient_at_particles, &
              node_offsets, spread_to_grid, mass_to_grid
 
+   !> volume_to_grid's extremes: particles per block (PARTICLE_BLOCK of grid_transfer_stencil.inc), and the
+   !> rows of a block's column: the least and the largest coordinate of each axis (1:3, 4:6), the largest
+   !> mass, the least density.
+   integer, parameter, public :: extremes_block = 64, extremes_rows = 8
+
    !> The kernel instances: shape function and dimension; APIC's are these + apic.
    integer, parameter :: kernels_linear_2d = 1, kernels_linear_3d = 2, kernels_bspline2_2d = 3, kernels_bspline2_3d = 4
    integer, parameter :: apic = 4
@@ -278,24 +283,67 @@ contains
    end subroutine node_offsets
 
    !> o_i += sum_p N_ip m_p / rho_p over all particles (src/stabilization/volume_correction.f90).
-   !> `stencils`: P2G's of this step (used when it holds this set's particles).
-   subroutine volume_to_grid(grid, particles, occupancy, stencils)
+   !> `stencils`: P2G's of this step (used when it holds this set's particles). `extremes(:, j)`, if given: the
+   !> extremes of the particles of block j (extremes_block particles from particle 1, extremes_rows rows; the
+   !> axes the grid lacks hold 0), taken while they are at hand.
+   subroutine volume_to_grid(grid, particles, occupancy, stencils, extremes)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(in) :: particles
       real(rp), intent(inout) :: occupancy(:)
       type(stencil_cache_t), intent(in), optional :: stencils
+      real(rp), intent(inout), optional :: extremes(:, :)
       select case (instance(grid))
-      case (kernels_linear_2d); call volume_to_grid_2d(grid, particles, occupancy)
-      case (kernels_linear_3d); call volume_to_grid_3d(grid, particles, occupancy, stencils)
-      case (kernels_bspline2_2d); call volume_to_grid_b2_2d(grid, particles, occupancy)
-      case default; call volume_to_grid_b2_3d(grid, particles, occupancy, stencils)
+      case (kernels_linear_2d); call volume_to_grid_2d(grid, particles, occupancy, extremes)
+      case (kernels_linear_3d); call volume_to_grid_3d(grid, particles, occupancy, extremes, stencils)
+      case (kernels_bspline2_2d); call volume_to_grid_b2_2d(grid, particles, occupancy, extremes)
+      case default; call volume_to_grid_b2_3d(grid, particles, occupancy, extremes, stencils)
       end select
    end subroutine volume_to_grid
 
-   !> gradient(:, p) = sum_a grad N_a(x_p) field_a for p = first..last at x^n; a node that is not `known`
-   !> takes the N-weighted mean of the particle's known stencil nodes. `stencils`: P2G's of this step (used
-   !> when it holds this set's particles).
-   subroutine gradient_at_particles(grid, particles, first, last, field, known, gradient, stencils)
+   !> The extremes of particles first:last into e (extremes_rows values, see extremes_block): loops with the
+   !> dimension written out, which vectorise.
+   subroutine particle_extremes(particles, first, last, e)
+      type(particle_set_t), intent(in) :: particles
+      integer, intent(in) :: first, last
+      real(rp), intent(out) :: e(extremes_rows)
+      real(rp) :: lo(3), hi(3), mass_max, density_min
+      integer :: p
+      lo = 0.0_rp
+      hi = 0.0_rp
+      mass_max = -huge(1.0_rp)
+      density_min = huge(1.0_rp)
+      if (particles%dim == 2) then
+         lo(1:2) = huge(1.0_rp)
+         hi(1:2) = -huge(1.0_rp)
+         do p = first, last
+            lo(1) = min(lo(1), particles%x(1, p))
+            lo(2) = min(lo(2), particles%x(2, p))
+            hi(1) = max(hi(1), particles%x(1, p))
+            hi(2) = max(hi(2), particles%x(2, p))
+            mass_max = max(mass_max, particles%mass(p))
+            density_min = min(density_min, particles%density(p))
+         end do
+      else
+         lo = huge(1.0_rp)
+         hi = -huge(1.0_rp)
+         do p = first, last
+            lo(1) = min(lo(1), particles%x(1, p))
+            lo(2) = min(lo(2), particles%x(2, p))
+            lo(3) = min(lo(3), particles%x(3, p))
+            hi(1) = max(hi(1), particles%x(1, p))
+            hi(2) = max(hi(2), particles%x(2, p))
+            hi(3) = max(hi(3), particles%x(3, p))
+            mass_max = max(mass_max, particles%mass(p))
+            density_min = min(density_min, particles%density(p))
+         end do
+      end if
+      e = [lo, hi, mass_max, density_min]
+   end subroutine particle_extremes
+
+   !> gradient(:, p) = factor sum_a grad N_a(x_p) field_a for p = first..last at x^n (factor default 1); a node
+   !> that is not `known` takes the N-weighted mean of the particle's known stencil nodes. `stencils`: P2G's of
+   !> this step (used when it holds this set's particles).
+   subroutine gradient_at_particles(grid, particles, first, last, field, known, gradient, stencils, factor)
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(in) :: particles
       integer, intent(in) :: first, last
@@ -303,12 +351,17 @@ contains
       logical, intent(in) :: known(:)
       real(rp), intent(inout) :: gradient(:, :)
       type(stencil_cache_t), intent(in), optional :: stencils
+      real(rp), intent(in), optional :: factor
+      real(rp) :: f
+      f = 1.0_rp
+      if (present(factor)) f = factor
       select case (instance(grid))
-      case (kernels_linear_2d); call gradient_at_particles_2d(grid, particles, first, last, field, known, gradient)
+      case (kernels_linear_2d); call gradient_at_particles_2d(grid, particles, first, last, field, known, f, gradient)
       case (kernels_linear_3d)
-         call gradient_at_particles_3d(grid, particles, first, last, field, known, gradient, stencils)
-      case (kernels_bspline2_2d); call gradient_at_particles_b2_2d(grid, particles, first, last, field, known, gradient)
-      case default; call gradient_at_particles_b2_3d(grid, particles, first, last, field, known, gradient, stencils)
+         call gradient_at_particles_3d(grid, particles, first, last, field, known, f, gradient, stencils)
+      case (kernels_bspline2_2d)
+         call gradient_at_particles_b2_2d(grid, particles, first, last, field, known, f, gradient)
+      case default; call gradient_at_particles_b2_3d(grid, particles, first, last, field, known, f, gradient, stencils)
       end select
    end subroutine gradient_at_particles
 
@@ -361,6 +414,7 @@ contains
 #define G2P grid_to_particles_2d
 #define V2G volume_to_grid_2d
 #define GRAD2P gradient_at_particles_2d
+#define GRADIENT_COEFFICIENTS gradient_coefficients_2d
 #define SPREAD2G spread_to_grid_2d
 #define MASS2G mass_to_grid_2d
 #include "../grid/multilinear_shape.inc"
@@ -374,6 +428,7 @@ contains
 #define G2P grid_to_particles_3d
 #define V2G volume_to_grid_3d
 #define GRAD2P gradient_at_particles_3d
+#define GRADIENT_COEFFICIENTS gradient_coefficients_3d
 #define SPREAD2G spread_to_grid_3d
 #define MASS2G mass_to_grid_3d
 #include "../grid/multilinear_shape.inc"
