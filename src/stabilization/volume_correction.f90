@@ -40,7 +40,7 @@ module volume_correction
    use scene_description, only: scene_t, shifts_particles, relaxes_to_eos
    use domain_decomposition, only: domain_t
    use background_grid, only: grid_t
-   use grid_transfer, only: volume_to_grid, gradient_at_particles, extremes_block, extremes_rows
+   use grid_transfer, only: volume_to_grid, gradient_at_particles, transfer_block, extremes_rows
    use stencil_cache, only: stencil_cache_t
    use node_halo, only: sum_shared_nodes
    use particle_set, only: particle_set_t
@@ -202,10 +202,10 @@ contains
       if (.not. allocated(self%excess)) allocate (self%excess(1, grid%node_count))
       self%excess = 0.0_rp
       if (allocated(self%block_extremes)) then
-         if (size(self%block_extremes, 2) < (particles%count - 1) / extremes_block + 1) deallocate (self%block_extremes)
+         if (size(self%block_extremes, 2) < (particles%count - 1) / transfer_block + 1) deallocate (self%block_extremes)
       end if
       if (.not. allocated(self%block_extremes)) &
-         allocate (self%block_extremes(extremes_rows, (size(particles%x, 2) - 1) / extremes_block + 1))
+         allocate (self%block_extremes(extremes_rows, (size(particles%x, 2) - 1) / transfer_block + 1))
       ! the occupancy, and the extremes of each block of particles that the height function's skip reads
       call volume_to_grid(grid, particles, self%excess(1, :), kept, self%block_extremes)
       call sum_shared_nodes(domain, grid, self%excess)
@@ -402,7 +402,7 @@ contains
       type(domain_t), intent(in) :: domain
       type(grid_t), intent(in) :: grid
       type(particle_set_t), intent(in) :: particles
-      integer, parameter :: block_size = 4 * extremes_block   ! 256: whole blocks of the extremes
+      integer, parameter :: block_size = 4 * transfer_block   ! 256: whole blocks of the extremes
       integer :: dim, k, p, corner, n(2), first(2, block_size), last(2, block_size), i, j, b, e, covered(2, 2)
       real(rp) :: box_hi(3), x(3), u, lo(2), hi(2), top(block_size), third, width, width_mass, width_density, &
                   widths(block_size), block_top
@@ -525,7 +525,7 @@ contains
          hi = -huge(1.0_rp)
          mass_max = 0.0_rp
          density_min = huge(1.0_rp)
-         do j = (b - 1) / extremes_block + 1, (e - 1) / extremes_block + 1
+         do j = (b - 1) / transfer_block + 1, (e - 1) / transfer_block + 1
             lo = min(lo, self%block_extremes(1:3, j))
             hi = max(hi, self%block_extremes(4:6, j))
             mass_max = max(mass_max, self%block_extremes(7, j))

@@ -18,10 +18,10 @@ module grid_transfer
    public :: particles_to_grid, update_velocity_and_remap, grid_to_particles, volume_to_grid, gradient_at_particles, &
              node_offsets, spread_to_grid, mass_to_grid
 
-   !> volume_to_grid's extremes: particles per block (PARTICLE_BLOCK of grid_transfer_stencil.inc), and the
-   !> rows of a block's column: the least and the largest coordinate of each axis (1:3, 4:6), the largest
-   !> mass, the least density.
-   integer, parameter, public :: extremes_block = 64, extremes_rows = 8
+   !> Particles per block of the kernels' loops (PARTICLE_BLOCK of grid_transfer_stencil.inc is this constant):
+   !> volume_to_grid's extremes come one column per such block. The rows of a column: the least and the largest
+   !> coordinate of each axis (1:3, 4:6), the largest mass, the least density.
+   integer, parameter, public :: transfer_block = 64, extremes_rows = 8
 
    !> The kernel instances: shape function and dimension; APIC's are these + apic.
    integer, parameter :: kernels_linear_2d = 1, kernels_linear_3d = 2, kernels_bspline2_2d = 3, kernels_bspline2_3d = 4
@@ -284,7 +284,7 @@ contains
 
    !> o_i += sum_p N_ip m_p / rho_p over all particles (src/stabilization/volume_correction.f90).
    !> `stencils`: P2G's of this step (used when it holds this set's particles). `extremes(:, j)`, if given: the
-   !> extremes of the particles of block j (extremes_block particles from particle 1, extremes_rows rows; the
+   !> extremes of the particles of block j (transfer_block particles from particle 1, extremes_rows rows; the
    !> axes the grid lacks hold 0), taken while they are at hand.
    subroutine volume_to_grid(grid, particles, occupancy, stencils, extremes)
       type(grid_t), intent(in) :: grid
@@ -300,7 +300,7 @@ contains
       end select
    end subroutine volume_to_grid
 
-   !> The extremes of particles first:last into e (extremes_rows values, see extremes_block): loops with the
+   !> The extremes of particles first:last into e (extremes_rows values, see transfer_block): loops with the
    !> dimension written out, which vectorise.
    subroutine particle_extremes(particles, first, last, e)
       type(particle_set_t), intent(in) :: particles
