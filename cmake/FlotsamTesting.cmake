@@ -55,6 +55,22 @@ function(flotsam_fail_on_array_copies)
   endforeach()
 endfunction()
 
+# Open MPI 4 keeps the session directories of all of a user's jobs in one $TMPDIR/ompi.<host>.<uid>; a
+# job that ends removes it when it is empty and can pull it away from a job that is just starting there
+# ("orte_session_dir failed", open-mpi/ompi#8510). `ctest -j` starts such jobs side by side, so every test
+# gets a TMPDIR of its own, <build>/tmp/<test name>. Called where flotsam_fail_on_array_copies is.
+function(flotsam_give_each_test_its_own_tmpdir)
+  get_property(folder_tests DIRECTORY PROPERTY TESTS)
+  foreach(test IN LISTS folder_tests)
+    get_test_property(${test} ENVIRONMENT environment)
+    if(NOT environment MATCHES "(^|;)TMPDIR=")
+      set(tmpdir "${CMAKE_BINARY_DIR}/tmp/${test}")
+      file(MAKE_DIRECTORY "${tmpdir}")
+      set_property(TEST ${test} APPEND PROPERTY ENVIRONMENT "TMPDIR=${tmpdir}")
+    endif()
+  endforeach()
+endfunction()
+
 # Fortran names: a letter, then letters, digits, underscores; 63 characters at most (F2018).
 # 60 for test procedures, to leave room for the pf_ prefix of the pFUnit wrappers.
 function(_flotsam_check_fortran_name what name max_length)
@@ -191,6 +207,7 @@ function(flotsam_add_test_suite)
   if(have_pfunit)
     _flotsam_add_pfunit_wrapper()
   endif()
+  flotsam_give_each_test_its_own_tmpdir()
 endfunction()
 
 # Part of flotsam_add_test_suite (a macro, so it sees the caller's variables): writes

@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """scripts/study on small studies of the hydrostatic tank:
   * 2 x 2 cases of 20 steps, 2 at once (--jobs 2): each case prints a line when it starts and when it
-    ends; results.csv has a row per case with its parameters, cost and accuracy columns; pareto.png;
+    ends, and runs with a TMPDIR of its own (Open MPI's session directories); results.csv has a row
+    per case with its parameters, cost and accuracy columns; pareto.png;
   * a second call runs nothing again (resumed), --case N runs (here: finds done) case N only;
   * the base scene changed: a case is not reused but run again, its old folder moved to superseded/
     (or, with --stale refuse, the study stops and the folder stays as it was);
@@ -118,8 +119,22 @@ def main():
     def run(*arguments):
         return subprocess.run(base + list(arguments), capture_output=True, text=True)
 
-    first = run("--jobs", "2")
+    # the first call through a launcher that notes the TMPDIR each case gets, then starts it
+    launches = os.path.join(work, "launches.log")
+    wrapper = os.path.join(work, "mpiexec_noting_tmpdir")
+    with open(wrapper, "w") as f:
+        f.write(f'#!/bin/sh\n[ -d "$TMPDIR" ] && there=exists || there=missing\n'
+                f'echo "${{TMPDIR:-unset}} $there" >> "{launches}"\nexec "{mpiexec}" "$@"\n')
+    os.chmod(wrapper, 0o755)
+    first = subprocess.run(base[:-1] + [wrapper, "--jobs", "2"], capture_output=True, text=True)
     checks.check(first.returncode == 0, "the study runs (--jobs 2)", first.stderr[-1500:])
+    with open(launches) as f:
+        started = [line.split() for line in f]
+    tmpdirs = {tmpdir for tmpdir, there in started if there == "exists"}
+    # Open MPI's session directories live in $TMPDIR: cases that share one can break each other's start
+    checks.check(len(started) == 4 and len(tmpdirs) == 4 and os.environ.get("TMPDIR") not in tmpdirs and
+                 not any(os.path.exists(d) for d in tmpdirs),
+                 "each case started with a TMPDIR of its own, removed after it", str(started))
     lines = first.stdout.splitlines()
     checks.check(sum(line.endswith(": started") for line in lines) == 4 and
                  sum(ended(line) and "(exit 0)" in line for line in lines) == 4 and
