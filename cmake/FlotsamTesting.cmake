@@ -36,12 +36,17 @@ if(FLOTSAM_USE_PFUNIT)
   endif()
 endif()
 
-# A Debug build (-fcheck=all) prints this line for each array gfortran copies to pass it to a procedure
-# (docs/conventions.md: gfortran 12 copies at every call, also in a Release build): every test of a folder
-# fails on it, its exit code apart. Called by flotsam_add_test_suite for its tests, and at the end of the
-# folders that add tests of their own (a test's properties can only be set in its folder).
+# The properties every test of a folder gets, whoever added it. Called by flotsam_add_test_suite, and at the
+# end of the folders that add tests of their own (a test's properties can only be set in its folder).
+#  - A Debug build (-fcheck=all) prints FLOTSAM_ARRAY_COPY_MESSAGE for each array gfortran copies to pass it
+#    to a procedure (docs/conventions.md: gfortran 12 copies at every call, also in a Release build): the
+#    test fails on it, its exit code apart.
+#  - Open MPI 4 keeps the session directories of all of a user's jobs in one $TMPDIR/ompi.<host>.<uid>; a
+#    job that ends removes it when it is empty and can pull it away from a job that is just starting there
+#    ("orte_session_dir failed", open-mpi/ompi#8510). `ctest -j` starts such jobs side by side, so the test
+#    gets a TMPDIR of its own, <build>/tmp/<test name>.
 set(FLOTSAM_ARRAY_COPY_MESSAGE "An array temporary was created")
-function(flotsam_fail_on_array_copies)
+function(flotsam_finish_folder_tests)
   get_property(folder_tests DIRECTORY PROPERTY TESTS)
   foreach(test IN LISTS folder_tests)
     get_test_property(${test} FAIL_REGULAR_EXPRESSION patterns)
@@ -52,16 +57,6 @@ function(flotsam_fail_on_array_copies)
       list(APPEND patterns "${FLOTSAM_ARRAY_COPY_MESSAGE}")
       set_tests_properties(${test} PROPERTIES FAIL_REGULAR_EXPRESSION "${patterns}")
     endif()
-  endforeach()
-endfunction()
-
-# Open MPI 4 keeps the session directories of all of a user's jobs in one $TMPDIR/ompi.<host>.<uid>; a
-# job that ends removes it when it is empty and can pull it away from a job that is just starting there
-# ("orte_session_dir failed", open-mpi/ompi#8510). `ctest -j` starts such jobs side by side, so every test
-# gets a TMPDIR of its own, <build>/tmp/<test name>. Called where flotsam_fail_on_array_copies is.
-function(flotsam_give_each_test_its_own_tmpdir)
-  get_property(folder_tests DIRECTORY PROPERTY TESTS)
-  foreach(test IN LISTS folder_tests)
     get_test_property(${test} ENVIRONMENT environment)
     if(NOT environment MATCHES "(^|;)TMPDIR=")
       set(tmpdir "${CMAKE_BINARY_DIR}/tmp/${test}")
@@ -200,14 +195,12 @@ function(flotsam_add_test_suite)
       TIMEOUT ${ARG_TIMEOUT})
   endif()
 
-  flotsam_fail_on_array_copies()
-
   # --- optional: the same procedures as pFUnit tests --------------------------------------------
   get_property(have_pfunit GLOBAL PROPERTY FLOTSAM_HAVE_PFUNIT)
   if(have_pfunit)
     _flotsam_add_pfunit_wrapper()
   endif()
-  flotsam_give_each_test_its_own_tmpdir()
+  flotsam_finish_folder_tests()
 endfunction()
 
 # Part of flotsam_add_test_suite (a macro, so it sees the caller's variables): writes
