@@ -35,6 +35,7 @@ module boundary_walls
    use particle_set, only: particle_set_t
    use wall_motion, only: wall_motion_t, prescribed_motion
    use time_table, only: time_table_t
+   use wall_pressure_taps, only: pressure_taps_t, wall_sensor_t, tangent_axes
    implicit none
    private
 
@@ -83,6 +84,9 @@ module boundary_walls
       type(shape_t) :: rest_shape
       real(rp) :: shift(3) = 0.0_rp, nodes_shift(3) = 0.0_rp
       real(rp) :: wall_velocity(3) = 0.0_rp
+      !> wall-pressure sensors on this wall and their taps on its nodes (wall_pressure_taps): a counted node's
+      !> impulse adds dp . vector to the sensor's column of the impulse accumulator, after the walls' columns
+      type(pressure_taps_t) :: taps
    end type wall_t
 
    !> Rows of an impulse accumulator (impulse_rows, wall): force impulse (3), then moment impulse (3), grid frame.
@@ -90,7 +94,8 @@ module boundary_walls
 
    public :: build_walls, box_side_walls, make_wall, make_structure, build_structures, set_wall_activity, &
              apply_wall_constraints, keep_particles_inside, behind_wall, wall_distance, unilateral_velocity, &
-             first_particle_inside, surface_normal, move_walls, place_moving_walls, moving_wall_speed
+             first_particle_inside, surface_normal, move_walls, place_moving_walls, moving_wall_speed, &
+             attach_wall_sensors
 
 contains
 
@@ -262,6 +267,7 @@ contains
          end do
       end do
       call keep_nodes(wall, grid, found(1:n), owned(1:n))
+      call place_taps(wall, grid)
    end subroutine find_wall_nodes
 
    !> The wall kind of a condition keyword ('slip', 'no_slip', 'friction').
@@ -393,7 +399,103 @@ contains
       if (allocated(wall%arm)) deallocate (wall%arm)
       call keep_nodes(wall, grid, found(1:n), owned(1:n))
       wall%node_normal = normals(:, 1:n)
+      call place_taps(wall, grid)
    end subroutine find_structure_nodes
+
+   !> The taps of the wall's sensors on its current nodes: each node's foot point on the surface and the
+   !> surface's normal there (a structure's per node).
+   subroutine place_taps(wall, grid)
+      type(wall_t), intent(inout) :: wall
+      type(grid_t), intent(in) :: grid
+      real(rp), allocatable :: feet(:, :), normals(:, :)
+      real(rp) :: x(grid%dim), phi
+      integer :: i, dim
+      if (.not. wall%taps%any()) return
+      dim = grid%dim
+      allocate (feet(dim, size(wall%nodes)), normals(dim, size(wall%nodes)))
+      do i = 1, size(wall%nodes)
+         x = grid%origin(1:dim) + grid%node_indices(wall%nodes(i)) * grid%h
+         if (wall%shaped) then
+            normals(:, i) = wall%node_normal(:, i)
+         else
+            normals(:, i) = wall%normal(1:dim)
+         end if
+         phi = wall_distance(wall, grid, x)
+         feet(:, i) = x - phi * normals(:, i)
+      end do
+      call wall%taps%place(dim, grid%h, feet, normals)
+   end subroutine place_taps
+
+   !> Put the wall-pressure sensors `sensors` (their slot, point in the world frame, radius) on the walls
+   !> of the loads.csv entries `entries` (per sensor), with the sensor's point moved onto the surface, the
+   !> surface's normal there and the intervals it can be wetted along grid axes (the scene box, cut by the
+   !> planar walls across them); then their taps. `offset` (per sensor) is how far the given point lay from
+   !> the surface [m] (the caller refuses a point off it).
+   subroutine attach_wall_sensors(walls, grid, sensors, entries, offset)
+      type(wall_t), intent(inout) :: walls(:)
+      type(grid_t), intent(in) :: grid
+      type(wall_sensor_t), intent(in) :: sensors(:)
+      integer, intent(in) :: entries(:)
+      real(rp), intent(out) :: offset(:)
+      type(wall_sensor_t) :: sensor
+      real(rp) :: x(grid%dim), phi, tangents(grid%dim, grid%dim - 1)
+      logical :: axes
+      integer :: s, w, v, k, along, dim
+      dim = grid%dim
+      offset = huge(1.0_rp)
+      do w = 1, size(walls)
+         if (allocated(walls(w)%taps%sensors)) deallocate (walls(w)%taps%sensors)
+         allocate (walls(w)%taps%sensors(0))
+      end do
+      do s = 1, size(sensors)
+         do w = 1, size(walls)
+            if (walls(w)%load /= entries(s)) cycle
+            sensor = sensors(s)
+            x = grid%frame%grid_point(sensors(s)%point(1:dim))
+            phi = wall_distance(walls(w), grid, x)
+            offset(s) = min(offset(s), abs(phi))
+            sensor%normal = 0.0_rp
+            sensor%normal(1:dim) = surface_normal(walls(w), grid, x)
+            sensor%point = 0.0_rp
+            sensor%point(1:dim) = x - phi * sensor%normal(1:dim)
+            call tangent_axes(sensor%normal(1:dim), dim, tangents, axes)
+            if (axes) then
+               do k = 1, dim - 1
+                  along = maxloc(abs(tangents(:, k)), 1)
+                  sensor%wet_lo(along) = grid%origin(along)
+                  sensor%wet_hi(along) = grid%origin(along) + grid%global_cells(along) * grid%h
+                  ! a planar wall across this axis, with the sensor on its fluid side and in its extent
+                  do v = 1, size(walls)
+                     if (v == w .or. walls(v)%shaped .or. walls(v)%axis /= along) cycle
+                     if (wall_distance(walls(v), grid, sensor%point(1:dim)) < -1.0e-9_rp * grid%h) cycle
+                     if (.not. in_extent(walls(v), grid, sensor%point(1:dim))) cycle
+                     if (walls(v)%normal(along) > 0.0_rp) then
+                        sensor%wet_lo(along) = max(sensor%wet_lo(along), walls(v)%point(along))
+                     else
+                        sensor%wet_hi(along) = min(sensor%wet_hi(along), walls(v)%point(along))
+                     end if
+                  end do
+               end do
+            end if
+            walls(w)%taps%sensors = [walls(w)%taps%sensors, sensor]
+         end do
+      end do
+      do w = 1, size(walls)
+         call place_taps(walls(w), grid)
+      end do
+   end subroutine attach_wall_sensors
+
+   !> True if the foot of the grid-frame point x on the planar wall lies in the wall's extent.
+   logical function in_extent(wall, grid, x)
+      type(wall_t), intent(in) :: wall
+      type(grid_t), intent(in) :: grid
+      real(rp), intent(in) :: x(:)
+      real(rp) :: foot(size(x))
+      integer :: d
+      d = size(x)
+      foot = grid%frame%world_point(x - wall_distance(wall, grid, x) * wall%normal(1:d))
+      in_extent = all(foot >= wall%lower(1:d) - wall%margin) .and. all(foot <= wall%upper(1:d) + wall%margin)
+   end function in_extent
 
    !> The sides of the scene box that `&box_walls` makes walls, as `&wall` entries: each is the face of
    !> the box lower..lower + ncells h (world frame), with the normal pointing into the box.
@@ -594,8 +696,8 @@ contains
                   velocity(:, node) = before - vn * n
                end select
                if (recording) then
-                  if (walls(w)%counted(i)) call add_impulse(impulse(:, w), mass(node) * (velocity(:, node) - before), &
-                                                            walls(w)%arm(1:dim, i))
+                  if (walls(w)%counted(i)) call record_impulse(walls(w), w, size(walls), i, &
+                                                               mass(node) * (velocity(:, node) - before), impulse)
                end if
                cycle
             end if
@@ -613,12 +715,30 @@ contains
                velocity(:, node) = before - vn * n
             end select
             if (recording) then
-               if (walls(w)%counted(i)) call add_impulse(impulse(:, w), mass(node) * (velocity(:, node) - before), &
-                                                         walls(w)%arm(1:dim, i))
+               if (walls(w)%counted(i)) call record_impulse(walls(w), w, size(walls), i, &
+                                                            mass(node) * (velocity(:, node) - before), impulse)
             end if
          end do
       end do
    end subroutine apply_wall_constraints
+
+   !> The impulse dp of the i-th node of `wall` (the w-th of n_walls) for the wall's load and its sensors'
+   !> columns n_walls + slot of `impulse`.
+   pure subroutine record_impulse(wall, w, n_walls, i, dp, impulse)
+      type(wall_t), intent(in) :: wall
+      integer, intent(in) :: w, n_walls, i
+      real(rp), intent(in) :: dp(:)
+      real(rp), intent(inout) :: impulse(:, :)
+      integer :: t, column
+      call add_impulse(impulse(:, w), dp, wall%arm(1:size(dp), i))
+      if (.not. allocated(wall%taps%first)) return
+      do t = wall%taps%first(i), wall%taps%first(i + 1) - 1
+         column = n_walls + wall%taps%slot(t)
+         ! a body field's accumulator (body_contact) has the walls' columns only
+         if (column > size(impulse, 2)) cycle
+         impulse(1, column) = impulse(1, column) + dot_product(dp, wall%taps%vector(:, t))
+      end do
+   end subroutine record_impulse
 
    !> The velocity v after a unilateral contact with Coulomb friction mu against a surface of unit normal
    !> n (pointing into the material): unchanged when separating (v.n >= 0); else the normal part v_n is

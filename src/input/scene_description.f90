@@ -221,6 +221,8 @@ module scene_description
    character(len=*), parameter, public :: gauge_pressure = 'pressure'
    character(len=*), parameter, public :: gauge_level = 'level'
    character(len=*), parameter, public :: gauge_velocity = 'velocity'
+   !> the pressure a wall or structure takes over a patch of its surface, from its constraint's impulse
+   character(len=*), parameter, public :: gauge_wall_pressure = 'wall_pressure'
 
    !> `&gauge`: a sensor of the fluid at a point, written to gauges.csv (docs/loads.md).
    type, public :: gauge_spec_t
@@ -230,6 +232,8 @@ module scene_description
       !> pressure, velocity: radius of the sphere (disc in 2-D) it averages over; level: half-width of the
       !> column it looks in [m]; 0: resolved to the cell size (pressure, velocity) or half of it (level)
       real(rp) :: radius = 0.0_rp
+      !> wall_pressure: the wall, box side or structure whose surface it lies on (its name in loads.csv)
+      character(len=name_len) :: wall = ''
    end type gauge_spec_t
 
    !> `&contact`: bodies of two solid materials (or of one, against each other), or of a solid material and

@@ -178,6 +178,7 @@ module scene_reader
       variable_info_t('gauge', 'kind', 'string', .true.), &
       variable_info_t('gauge', 'point', 'real3', .true.), &
       variable_info_t('gauge', 'radius', 'real', .false.), &
+      variable_info_t('gauge', 'wall', 'string', .false.), &
       variable_info_t('contact', 'between', 'string2', .true.), &
       variable_info_t('contact', 'friction', 'real', .false.), &
       variable_info_t('structure', 'name', 'string', .false.), &
@@ -1358,17 +1359,19 @@ contains
       integer, intent(out) :: ios
       character(len=*), intent(inout) :: message
       character(len=*), intent(in) :: text
-      character(len=text_len) :: name, kind
+      character(len=text_len) :: name, kind, wall
       real(rp) :: point(3), radius
-      namelist /gauge/ name, kind, point, radius
+      namelist /gauge/ name, kind, point, radius, wall
 
       name = spec%name
       kind = spec%kind
       point = spec%point
       radius = spec%radius
+      wall = spec%wall
       read (text, nml=gauge, iostat=ios, iomsg=message)
       call take_text('name', name, spec%name, ios, message)
       call take_text('kind', kind, spec%kind, ios, message, fold='lower')
+      call take_text('wall', wall, spec%wall, ios, message)
       if (ios /= 0) return
       spec%point = point
       spec%radius = radius

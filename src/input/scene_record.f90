@@ -433,6 +433,8 @@ contains
             text = reals(gauge%point)
          case ('radius')
             text = real_text(gauge%radius)
+         case ('wall')
+            text = quoted(gauge%wall)
          case default
             text = ''
          end select

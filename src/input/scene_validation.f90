@@ -11,7 +11,7 @@ module scene_validation
                                 has_velocity_file, motion_spec_t, structure_shape, &
                                 wall_slip, wall_no_slip, wall_friction, motion_none, motion_solitary_wave, motion_table, &
                                 model_newtonian_fluid, model_linear_elastic, model_rigid, gauge_pressure, gauge_level, &
-                                gauge_velocity, &
+                                gauge_velocity, gauge_wall_pressure, &
                                 particle_field_names, field_precision_keywords
    use input_text, only: int_text, real_text, quoted_list, group_context, ordinal
    use memory_budget, only: memory_budget_t, byte_text
@@ -73,7 +73,7 @@ module scene_validation
       [character(len=15) :: model_newtonian_fluid, model_linear_elastic, model_rigid]
    !> Accepted `&gauge kind=` keywords (stored lower case).
    character(len=*), parameter, public :: gauge_kind_keywords(*) = &
-      [character(len=8) :: gauge_pressure, gauge_level, gauge_velocity]
+      [character(len=13) :: gauge_pressure, gauge_level, gauge_velocity, gauge_wall_pressure]
 
    !> Relative tolerance of "extent is a whole multiple of cell_size".
    real(rp), parameter :: multiple_tolerance = 1.0e-9_rp
@@ -160,6 +160,8 @@ contains
          end do
       end if
       call validate_load_names(scene, path, status)
+      if (.not. status%ok) return
+      call validate_gauge_walls(scene, path, status)
       if (.not. status%ok) return
       if (allocated(scene%contacts)) then
          do i = 1, size(scene%contacts)
@@ -437,7 +439,7 @@ contains
          associate (gauge => scene%gauges(g))
             ! Validated >= 0, so not > 0 means 0: one cell, a level gauge's column half a cell either side.
             if (.not. gauge%radius > 0.0_rp) then
-               if (gauge%kind == gauge_level) then
+               if (gauge%kind == gauge_level .or. gauge%kind == gauge_wall_pressure) then
                   gauge%radius = 0.5_rp * scene%grid%cell_size
                else
                   gauge%radius = scene%grid%cell_size
@@ -1522,6 +1524,92 @@ contains
          end do
       end associate
    end subroutine validate_gauge
+
+   !> A wall_pressure gauge names the wall, box side or structure it lies on (its name in loads.csv, given or
+   !> default; that it lies on the surface is checked when the walls are built); the other kinds take no `wall`.
+   subroutine validate_gauge_walls(scene, path, status)
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: path
+      type(status_t), intent(inout) :: status
+      character(len=name_len), allocatable :: surfaces(:)
+      character(len=:), allocatable :: where
+      integer :: g
+      if (.not. allocated(scene%gauges)) return
+      surfaces = surface_names(scene)
+      do g = 1, size(scene%gauges)
+         associate (gauge => scene%gauges(g))
+            where = group_context(path, 'gauge', g, name_detail(gauge%name))
+            if (gauge%kind /= gauge_wall_pressure) then
+               if (len_trim(gauge%wall) > 0) then
+                  call status%fail(where//": variable wall is used by kind 'wall_pressure' only, got kind '"// &
+                                   trim(gauge%kind)//"'")
+                  return
+               end if
+               cycle
+            end if
+            if (len_trim(gauge%wall) == 0) then
+               call status%fail(where//": variable wall is required for kind 'wall_pressure' (the name of the "// &
+                                'wall, box side or structure the gauge lies on, as in loads.csv)')
+               return
+            end if
+            if (any(moving_surfaces(scene) == gauge%wall)) then
+               call status%fail(where//": variable wall names '"//trim(gauge%wall)//"', which moves (its "// &
+                                'motion): a wall_pressure gauge reads a fixed wall or structure')
+               return
+            end if
+            if (all(surfaces /= gauge%wall)) then
+               if (size(surfaces) == 0) then
+                  call status%fail(where//": variable wall names '"//trim(gauge%wall)//"', but the scene has no "// &
+                                   'wall, box side wall or structure')
+               else
+                  call status%fail(where//": variable wall must be the name of a wall, box side or structure, "// &
+                                   quoted_list(surfaces)//", got '"//trim(gauge%wall)//"'")
+               end if
+               return
+            end if
+         end associate
+      end do
+   end subroutine validate_gauge_walls
+
+   !> The names of the scene's constraining surfaces, as loads.csv names them: box sides that are walls,
+   !> &wall groups, &structure groups (given names or the defaults).
+   function surface_names(scene) result(names)
+      type(scene_t), intent(in) :: scene
+      character(len=name_len), allocatable :: names(:)
+      integer :: k, side, i
+      allocate (names(0))
+      do k = 1, 3
+         do side = 1, 2
+            if (scene%grid%wall(side, k) == wall_none) cycle
+            names = [names, given_or(scene%grid%wall_name(side, k), side_name(side, k))]
+         end do
+      end do
+      names = [names, (given_or(scene%walls(i)%name, default_name('wall', i)), i = 1, wall_count(scene))]
+      names = [names, (given_or(scene%structures(i)%name, default_name('structure', i)), i = 1, structure_count(scene))]
+   end function surface_names
+
+   !> The names of the &wall and &structure groups that move (a `motion` other than 'none').
+   function moving_surfaces(scene) result(names)
+      type(scene_t), intent(in) :: scene
+      character(len=name_len), allocatable :: names(:)
+      integer :: i
+      allocate (names(0))
+      do i = 1, wall_count(scene)
+         if (scene%walls(i)%motion%kind /= motion_none) names = [names, given_or(scene%walls(i)%name, default_name('wall', i))]
+      end do
+      do i = 1, structure_count(scene)
+         if (scene%structures(i)%motion%kind /= motion_none) &
+            names = [names, given_or(scene%structures(i)%name, default_name('structure', i))]
+      end do
+   end function moving_surfaces
+
+   !> `given` if the scene gave it, else `default` (a name of loads.csv).
+   pure function given_or(given, default) result(name)
+      character(len=*), intent(in) :: given, default
+      character(len=name_len) :: name
+      name = default
+      if (len_trim(given) > 0) name = given
+   end function given_or
 
    !> `&contact`: two declared solid materials (fluid-solid contact is not implemented: a fluid shares the
    !> common velocity field, docs/contact.md), or a solid material and a `&structure` (by its name, default

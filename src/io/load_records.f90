@@ -98,12 +98,15 @@ contains
       real(rp), allocatable :: values(:)
       interval = solver%time - solver%loads%last_row_time
       if (interval <= 0.0_rp) return
-      if (self%used(file_loads)) then
+      ! the loads' row also gives the wall-pressure gauges' means (sensor_pressure): taken before the gauges
+      if (self%used(file_loads) .or. solver%loads%sensors > 0) then
          values = solver%loads%row_values(solver%grid%frame, interval, solver%domain%comm, solver%domain%nranks)
-         if (solver%domain%rank == 0) call self%files(file_loads)%write_row(row_text(solver%time, values))
+         if (solver%domain%rank == 0 .and. self%used(file_loads)) &
+            call self%files(file_loads)%write_row(row_text(solver%time, values))
       end if
       if (self%used(file_gauges)) then
-         values = solver%gauges%sample(solver%particles, solver%materials, solver%grid%frame, solver%domain%comm)
+         values = solver%gauges%sample(solver%particles, solver%materials, solver%grid%frame, solver%domain%comm, &
+                                       solver%loads%sensor_pressure)
          if (solver%domain%rank == 0) call self%files(file_gauges)%write_row(row_text(solver%time, values))
       end if
       if (self%used(file_bodies)) then
@@ -185,7 +188,9 @@ contains
          call file%write_row('# units: time s; _fx _fy _fz '//force//'; _mx _my _mz '//moment//per_depth)
       case (file_gauges)
          call file%write_row('# gauges.csv: readings of the &gauge sensors at the row''s time, world frame; '// &
-                             '<name>_samples = fluid particles the gauge saw (0: none, the value is then 0)')
+                             '<name>_samples = fluid particles the gauge saw (0: none, the value is then 0); a '// &
+                             'wall_pressure gauge (no _samples) is the mean pressure its wall took over its patch '// &
+                             'in the interval since the previous row')
          call file%write_row('# units: time s; _pressure Pa; _level m (free surface above the gauge point); '// &
                              '_vx _vy _vz m/s; _samples count')
       case default

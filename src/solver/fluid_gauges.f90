@@ -13,13 +13,17 @@
 !>             column of half-width `radius` through the point, the highest top of a fluid particle
 !>             (centre + half its size (m / rho)^(1/dim) along the vertical) minus the point's
 !>             elevation, at least 0. Vertical is -g, or +y (2-D) / +z (3-D) without gravity.
-!> Each gauge also writes the number of particles it saw (`<name>_samples`): 0 means no fluid there,
-!> and the values are then 0. Collective: two reductions (sums, maxima) for all gauges together.
+!>   wall_pressure  the mean pressure the wall `wall` takes over a patch of its surface about the point
+!>             (half-size `radius`), from its constraint's impulse over the row's interval (wall_pressure_taps,
+!>             wall_loads): the load the wall feels, not the particles' pressure next to it, which the
+!>             constraint bypasses in part (docs/loads.md, "Wall pressure").
+!> Each particle gauge also writes the number of particles it saw (`<name>_samples`): 0 means no fluid
+!> there, and the values are then 0. Collective: two reductions (sums, maxima) for all gauges together.
 module fluid_gauges
    use kinds, only: rp, name_len
    use communication_counters, only: count_collective, comm_records, real_bytes
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_SUM, MPI_MAX
-   use scene_description, only: scene_t, gauge_pressure, gauge_level, gauge_velocity
+   use scene_description, only: scene_t, gauge_pressure, gauge_level, gauge_velocity, gauge_wall_pressure
    use material_model, only: material_slot_t
    use particle_set, only: particle_set_t
    use tensor_layout, only: mean_stress
@@ -36,6 +40,7 @@ module fluid_gauges
       real(rp) :: point(3) = 0.0_rp            !< grid frame
       real(rp) :: radius = 0.0_rp
       integer :: first_sum = 0, first_max = 0  !< where its partial sums / maxima start in the packed arrays
+      integer :: slot = 0                      !< wall_pressure: its index among the wall-pressure gauges
    end type gauge_t
 
    type, public :: fluid_gauges_t
@@ -57,8 +62,9 @@ contains
       type(scene_t), intent(in) :: scene
       type(frame_t), intent(in) :: frame
       real(rp), intent(in) :: gravity(3)          !< grid frame
-      integer :: g, d
+      integer :: g, d, slots
       d = scene%grid%dim
+      slots = 0
       self%dim = d
       self%up = 0.0_rp
       if (norm2(gravity(1:d)) > 0.0_rp) then
@@ -87,6 +93,9 @@ contains
             case (gauge_level)
                self%n_sums = self%n_sums + 1          ! particles in the column
                self%n_max = self%n_max + 1            ! highest top
+            case (gauge_wall_pressure)
+               slots = slots + 1                      ! read from the wall's impulse, no particle sums
+               gauge%slot = slots
             case default
                self%n_sums = self%n_sums + fit_width(d, quantity_count(gauge%kind, d))
             end select
@@ -115,13 +124,15 @@ contains
    end function fit_width
 
    !> The row of gauges.csv now: per gauge its value(s) (pressure [Pa]; level [m]; vx, vy[, vz] [m/s],
-   !> world frame) and the number of particles it saw. Collective.
-   function gauges_sample(self, particles, materials, frame, comm) result(values)
+   !> world frame) and the number of particles it saw; a wall-pressure gauge its entry of `wall_pressures`
+   !> (wall_loads' sensor_pressure of the same row) alone. Collective.
+   function gauges_sample(self, particles, materials, frame, comm, wall_pressures) result(values)
       class(fluid_gauges_t), intent(in) :: self
       type(particle_set_t), intent(in) :: particles
       type(material_slot_t), intent(in) :: materials(:)
       type(frame_t), intent(in) :: frame
       type(MPI_Comm), intent(in) :: comm
+      real(rp), intent(in) :: wall_pressures(:)
       real(rp), allocatable :: values(:)
       real(rp) :: sums(self%n_sums), maxima(max(1, self%n_max)), dx(self%dim), q(self%dim), m, rise, size_p, &
                   across(self%dim), n_seen
@@ -136,6 +147,7 @@ contains
          do p = particles%material_first(mat), particles%material_last(mat)
             do g = 1, size(self%gauges)
                associate (gauge => self%gauges(g))
+                  if (gauge%kind == gauge_wall_pressure) cycle
                   dx = particles%x(:, p) - gauge%point(1:d)
                   m = particles%mass(p)
                   if (gauge%kind == gauge_level) then
@@ -194,6 +206,8 @@ contains
             case (gauge_velocity)
                q = fitted_values(sums(gauge%first_sum:gauge%first_sum + fit_width(d, d) - 1), d, d, gauge%radius)
                values = [values, frame%world_vector(q), sums(gauge%first_sum)]
+            case (gauge_wall_pressure)
+               values = [values, wall_pressures(gauge%slot)]
             end select
          end associate
       end do
@@ -268,13 +282,17 @@ contains
       integer :: g, k, n
       n = 0
       do g = 1, self%count()
-         n = n + merge(self%dim, 1, self%gauges(g)%kind == gauge_velocity) + 1
+         n = n + column_count(self%gauges(g)%kind, self%dim)
       end do
       allocate (columns(n))
       n = 0
       do g = 1, self%count()
          associate (name => self%gauges(g)%name)
             select case (self%gauges(g)%kind)
+            case (gauge_wall_pressure)
+               columns(n + 1) = trim(name)//'_pressure'
+               n = n + 1
+               cycle
             case (gauge_pressure)
                columns(n + 1) = trim(name)//'_pressure'
             case (gauge_level)
@@ -284,9 +302,23 @@ contains
                   columns(n + k) = trim(name)//'_v'//axes(k)
                end do
             end select
-            n = n + merge(self%dim, 1, self%gauges(g)%kind == gauge_velocity) + 1
+            n = n + column_count(self%gauges(g)%kind, self%dim)
             columns(n) = trim(name)//'_samples'
          end associate
       end do
    end function gauges_column_names
+
+   !> Columns of gauges.csv of a gauge of `kind`: its value(s) and the particles it saw; a wall pressure alone.
+   pure integer function column_count(kind, dim)
+      character(len=*), intent(in) :: kind
+      integer, intent(in) :: dim
+      select case (kind)
+      case (gauge_wall_pressure)
+         column_count = 1
+      case (gauge_velocity)
+         column_count = dim + 1
+      case default
+         column_count = 2
+      end select
+   end function column_count
 end module fluid_gauges

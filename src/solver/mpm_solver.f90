@@ -17,7 +17,8 @@ module mpm_solver
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use error_status, only: status_t
    use communication_counters, only: count_collective, comm_time_step, comm_balance, comm_other, real_bytes, int8_bytes
-   use scene_description, only: scene_t, run_control_t, wall_spec_t, model_newtonian_fluid
+   use scene_description, only: scene_t, run_control_t, wall_spec_t, model_newtonian_fluid, gauge_wall_pressure
+   use wall_pressure_taps, only: wall_sensor_t
    use domain_decomposition, only: domain_t, layout_dims, fit_box, min_slab_width
    use shape_functions, only: shape_function_kind, ghost_node_layers, shape_linear
    use load_balance, only: balanced_layout
@@ -39,7 +40,7 @@ module mpm_solver
    use volume_correction, only: volume_corrector_t, max_shift_in_cells
    use boundary_walls, only: wall_t, build_walls, build_structures, set_wall_activity, apply_wall_constraints, &
                              keep_particles_inside, first_particle_inside, box_side_walls, wall_distance, move_walls, &
-                             place_moving_walls, moving_wall_speed
+                             place_moving_walls, moving_wall_speed, attach_wall_sensors
    use fluid_inflow, only: inlet_t, build_inlets
    use wall_loads, only: wall_loads_t
    use fluid_gauges, only: fluid_gauges_t
@@ -82,6 +83,8 @@ module mpm_solver
       type(wall_t), allocatable :: walls(:)
       type(inlet_t), allocatable :: inlets(:)
       type(wall_loads_t) :: loads               !< impulse of every wall since the last row of loads.csv
+      !> per wall-pressure gauge, how far its point lies from the surface of its wall [m] (checked at the start)
+      real(rp), allocatable :: sensor_offset(:)
       type(fluid_gauges_t) :: gauges            !< the &gauge sensors (gauges.csv)
       type(body_motion_t) :: bodies             !< the solid bodies (bodies.csv)
       type(contact_t) :: contact                !< velocity fields of the bodies in contact (&contact)
@@ -166,8 +169,10 @@ contains
       call self%volume%init(scene, self%gravity)
       call agree_on_status(status, self%domain%comm)
       if (.not. status%ok) return
-      call build_boundaries(self)
       call self%loads%init(scene)
+      call build_boundaries(self)
+      call check_wall_sensors(self, status)
+      if (.not. status%ok) return
       call self%gauges%init(scene, frame, self%gravity)
       call self%bodies%init(scene, self%materials, frame, self%gravity)
       call self%contact%init(scene, self%bodies, size(self%materials))
@@ -228,6 +233,56 @@ contains
    !> scene, in the order of the entries of loads.csv.
    subroutine build_boundaries(self)
       type(solver_t), intent(inout) :: self
+      call build_walls_and_structures(self)
+      call attach_sensors(self)
+   end subroutine build_boundaries
+
+   !> The wall-pressure gauges (in gauges.csv order) on the walls of the loads.csv entries they name.
+   subroutine attach_sensors(self)
+      type(solver_t), intent(inout) :: self
+      type(wall_sensor_t), allocatable :: sensors(:)
+      integer, allocatable :: entries(:)
+      integer :: g, e
+      allocate (sensors(0), entries(0))
+      if (allocated(self%scene%gauges)) then
+         do g = 1, size(self%scene%gauges)
+            associate (gauge => self%scene%gauges(g))
+               if (gauge%kind /= gauge_wall_pressure) cycle
+               sensors = [sensors, wall_sensor_t(slot=size(sensors) + 1, point=gauge%point, radius=gauge%radius)]
+               e = findloc(self%loads%names, gauge%wall, 1)
+               entries = [entries, e]
+            end associate
+         end do
+      end if
+      if (allocated(self%sensor_offset)) deallocate (self%sensor_offset)
+      allocate (self%sensor_offset(size(sensors)))
+      if (size(sensors) > 0) call attach_wall_sensors(self%walls, self%grid, sensors, entries, self%sensor_offset)
+   end subroutine attach_sensors
+
+   !> A wall-pressure gauge's point must lie on its wall's surface (within half a cell, on the rank that
+   !> has the wall: every rank builds all walls).
+   subroutine check_wall_sensors(self, status)
+      type(solver_t), intent(in) :: self
+      type(status_t), intent(inout) :: status
+      integer :: g, slot
+      slot = 0
+      if (.not. allocated(self%scene%gauges)) return
+      do g = 1, size(self%scene%gauges)
+         associate (gauge => self%scene%gauges(g))
+            if (gauge%kind /= gauge_wall_pressure) cycle
+            slot = slot + 1
+            if (self%sensor_offset(slot) <= 0.5_rp * self%grid%h) cycle
+            call status%fail(group_context(self%scene%source_file, 'gauge', g, "name '"//trim(gauge%name)//"'")// &
+                             ': variable point lies '//trim(real_text(self%sensor_offset(slot)))// &
+                             " m from the surface of wall '"//trim(gauge%wall)// &
+                             "' (a wall_pressure gauge must lie on it, within half a cell)")
+            return
+         end associate
+      end do
+   end subroutine check_wall_sensors
+
+   subroutine build_walls_and_structures(self)
+      type(solver_t), intent(inout) :: self
       type(wall_spec_t), allocatable :: no_walls(:)
       integer :: entries
       if (allocated(self%scene%walls)) then
@@ -253,7 +308,7 @@ contains
       else
          call build_structures(self%scene%structures, self%grid, entries, self%walls, self%scene%gravity, self%time)
       end if
-   end subroutine build_boundaries
+   end subroutine build_walls_and_structures
 
    !> A structure displaces the fluid: the particles of fluid bodies seeded inside it (phi < 0) are not
    !> kept, so that a structure can stand in water at rest [R]. Solid bodies are not cut (check_structures_clear

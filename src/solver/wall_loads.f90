@@ -8,6 +8,9 @@
 !> per step. A row sums the ranks' impulses (one reduction) and divides by the interval's length,
 !> F = -J / (t - t_prev), so that no impulse is lost between rows. Each rank's impulse is saved in
 !> checkpoints (checkpoint.f90): a restart on the same ranks continues the rows bit for bit.
+!> Wall-pressure gauges (wall_pressure_taps) add one column each after the walls' in the step's record and
+!> one entry each after loads.csv's, summed and saved the same way but written to gauges.csv: row_values
+!> leaves their interval means in `sensor_pressure`.
 !> With contact body fields (body_contact), every structure has one more entry per body field,
 !> `<structure>_by_<body>`: the part of the structure's impulse given to that body's field (nodes and
 !> safeguard); the structure's own entry keeps the total, the rest of which is the common field's.
@@ -15,7 +18,7 @@ module wall_loads
    use kinds, only: rp, name_len
    use communication_counters, only: count_collective, comm_records, real_bytes
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_SUM
-   use scene_description, only: scene_t, wall_spec_t
+   use scene_description, only: scene_t, wall_spec_t, gauge_wall_pressure
    use boundary_walls, only: wall_t, impulse_rows, box_side_walls
    use body_contact, only: contact_body_names
    use world_frame, only: frame_t
@@ -33,6 +36,9 @@ module wall_loads
       !> (impulse_rows, wall, field) body field f's part of step_impulse(:, wall)
       real(rp), allocatable :: field_impulse(:, :, :)
       real(rp), allocatable :: impulse(:, :)             !< (impulse_rows, entry) this rank, since last row
+      integer :: sensors = 0                             !< wall-pressure gauges: entries after the names'
+      !> per wall-pressure gauge, its mean pressure over the interval of the last row [Pa]
+      real(rp), allocatable :: sensor_pressure(:)
       !> time of the last row of loads.csv, gauges.csv and bodies.csv: the start of the interval now
       !> accumulating (0 at the start of a run; saved in checkpoints)
       real(rp) :: last_row_time = 0.0_rp
@@ -82,18 +88,22 @@ contains
             self%names = [self%names, entry]
          end do
       end do
-      allocate (self%impulse(impulse_rows, size(self%names)))
+      self%sensors = 0
+      if (allocated(scene%gauges)) self%sensors = count(scene%gauges%kind == gauge_wall_pressure)
+      allocate (self%impulse(impulse_rows, size(self%names) + self%sensors), self%sensor_pressure(self%sensors))
       self%impulse = 0.0_rp
+      self%sensor_pressure = 0.0_rp
    end subroutine loads_init
 
-   !> Clear this step's record of the walls (the walls of the current layout: their number never changes).
+   !> Clear this step's record of the walls (the walls of the current layout: their number never changes)
+   !> and of the wall-pressure gauges (a column each after the walls').
    subroutine loads_begin_step(self, n_walls)
       class(wall_loads_t), intent(inout) :: self
       integer, intent(in) :: n_walls
-      if (.not. allocated(self%step_impulse)) allocate (self%step_impulse(impulse_rows, n_walls))
-      if (size(self%step_impulse, 2) /= n_walls) then
+      if (.not. allocated(self%step_impulse)) allocate (self%step_impulse(impulse_rows, n_walls + self%sensors))
+      if (size(self%step_impulse, 2) /= n_walls + self%sensors) then
          deallocate (self%step_impulse)
-         allocate (self%step_impulse(impulse_rows, n_walls))
+         allocate (self%step_impulse(impulse_rows, n_walls + self%sensors))
       end if
       self%step_impulse = 0.0_rp
       if (allocated(self%field_impulse)) then
@@ -111,6 +121,10 @@ contains
       do w = 1, size(walls)
          if (walls(w)%load > 0) self%impulse(:, walls(w)%load) = self%impulse(:, walls(w)%load) + self%step_impulse(:, w)
       end do
+      do s = 1, self%sensors
+         e = size(self%names) + s
+         self%impulse(:, e) = self%impulse(:, e) + self%step_impulse(:, size(walls) + s)
+      end do
       if (self%fields == 0) return
       do w = 1, size(walls)
          s = walls(w)%load - self%first_structure
@@ -124,8 +138,9 @@ contains
 
    !> The row of loads.csv for the interval of length `interval` that ends now, in the world frame, and
    !> the impulse cleared for the next interval: per entry the force the material exerts on the wall
-   !> (fx, fy[, fz]) and its moment (2-D mz; 3-D mx, my, mz) [N, N m; per metre of depth in 2-D].
-   !> Collective (one small reduction; none on one rank).
+   !> (fx, fy[, fz]) and its moment (2-D mz; 3-D mx, my, mz) [N, N m; per metre of depth in 2-D]; the
+   !> wall-pressure gauges' interval means go to sensor_pressure. Collective (one small reduction; none on
+   !> one rank).
    function loads_row_values(self, frame, interval, comm, nranks) result(values)
       class(wall_loads_t), intent(inout) :: self
       type(frame_t), intent(in) :: frame
@@ -133,8 +148,8 @@ contains
       type(MPI_Comm), intent(in) :: comm
       integer, intent(in) :: nranks
       real(rp), allocatable :: values(:)
-      real(rp) :: total(impulse_rows, size(self%names))
-      integer :: e, at, d
+      real(rp) :: total(impulse_rows, size(self%impulse, 2))
+      integer :: e, at, d, s
       d = self%dim
       total = self%impulse
       if (nranks > 1 .and. size(total) > 0) then
@@ -154,6 +169,10 @@ contains
             values(at + 1:at + 3) = -frame%world_vector(total(4:6, e)) / interval
             at = at + 3
          end if
+      end do
+      ! a sensor's column holds sum w dp . n / |patch|: p dt
+      do s = 1, self%sensors
+         self%sensor_pressure(s) = total(1, size(self%names) + s) / interval
       end do
       self%impulse = 0.0_rp
    end function loads_row_values

@@ -166,7 +166,8 @@ contains
          solver%particles%sbar(1:3, i) = -p / solver%particles%density(i)
          solver%particles%v(:, i) = v0 + matmul(dv, x)
       end do
-      values = solver%gauges%sample(solver%particles, solver%materials, solver%grid%frame, solver%domain%comm)
+      values = solver%gauges%sample(solver%particles, solver%materials, solver%grid%frame, solver%domain%comm, &
+                                    solver%loads%sensor_pressure)
       ! inside: p, samples; wall: p, samples; flow: vx, vy, samples; eta: level, samples; dry: p, samples
       call assertEqual(11, size(values), 'gauge columns')
       call assertRelativelyEqual(p0 + dot_product(grad, [0.73_rp, 0.31_rp]), values(1), 1.0e-10_rp, 'pressure inside')
