@@ -13,6 +13,9 @@ them by their columns:
   Lobovsky et al. 2014, H = 300 mm (columns t_star, p1_star, ...): t* = t sqrt(g/H), p* = p/(rho g H);
   converted to s and Pa with H = 0.3 m, g = 9.81 m/s2, rho = 1000 kg/m3. The run's gauges p1, p2, p3,
   p4 are compared (inputs/validation/lobovsky_h300.nml).
+  Lobovsky et al. 2014, H = 300 mm, water levels (columns t_star, H1_etsin01_star, H2_etsin01_star,
+  H2_etsin02_star, ...; level* = h/H): the run's level gauges H1 ... H4 are compared with the mean of a
+  gauge's series; the NMAE between its two series (the measurement's own scatter) is reported beside.
 
 For every sensor the run has, it reports (one row per sensor and quantity):
   arrival      first time the 10 ms running mean exceeds the threshold (pressure 300 Pa, level 5 mm:
@@ -21,8 +24,9 @@ For every sensor the run has, it reports (one row per sensor and quantity):
                default: the times of the checks below);
   peak         the largest 1 ms mean within 50 ms after the arrival (the first impact; the measurement is
                averaged over 1 ms bins first, so that both are seen through the same window);
-  nmae         water levels only: the normalised mean absolute error over 0 .. 1.5 s of the 10 ms means,
-               mean |sim - exp| / mean |exp|, both on the measurement's 1 ms grid.
+  nmae         water levels only: the normalised mean absolute error over 0 .. 1.5 s (or to the end of the
+               shorter series) of the 10 ms means, mean |sim - exp| / mean |exp|, both on a 1 ms grid;
+  scatter      where a gauge was measured twice: the NMAE of one series against the other.
 and the ratio or difference against the measurement. --csv writes the table (pandas.read_csv reads it),
 --plot one panel per sensor, simulation against measurement (both as 10 ms running means, the raw run
 faintly).
@@ -36,12 +40,15 @@ exits 1 if one fails:
   0.625, 0.675 s) within 20 % at sensor 1 and 25 % at sensors 2 and 3; the first-impact peak at sensor 1
   within a factor 2 of the measured event's (the peaks of repeated dam breaks scatter widely, the file is
   one event: docs/validation.md says why a factor 2).
+  Lobovsky H = 300 mm, water levels: H1-H4 NMAE over 0-1.0 s within 10 % (the criterion of the SPHERIC
+  levels).
 Exit status 2 for unusable input (a missing file, a data file of unknown layout, no sensor in common).
 Needs Debian's python3-numpy, python3-pandas and python3-matplotlib.
 """
 
 import argparse
 import os
+import re
 import sys
 
 try:
@@ -61,18 +68,21 @@ MEAN_WINDOW = 0.010            # s: the 10 ms means
 PEAK_BIN = 0.001               # s: the bins both series are averaged over before the peak
 PEAK_SEARCH = 0.050            # s after the arrival in which the first-impact peak is taken
 NMAE_WINDOW = (0.0, 1.5)       # s
+LOBOVSKY_LEVEL_WINDOW = (0.0, 1.0)   # s: the scene's length (the reflected bore comes back after it)
 
 
 class Experiment:
     """A measured data set: name, series (time in s, sensors in Pa or m) and its checks."""
 
-    def __init__(self, name, series, pressures, levels, times, checks):
+    def __init__(self, name, series, pressures, levels, times, checks, scatter=None, nmae_window=NMAE_WINDOW):
         self.name = name
         self.series = series
         self.pressures = pressures
         self.levels = levels
         self.times = times
         self.checks = checks
+        self.scatter = scatter or {}   # sensor -> NMAE between two measurements of it
+        self.nmae_window = nmae_window
 
 
 def read_experiment(path):
@@ -93,8 +103,28 @@ def read_experiment(path):
                 pressures.append(name)
         return Experiment("Lobovsky et al. 2014, H = 300 mm", series, pressures, [],
                           [0.475, 0.525, 0.575, 0.625, 0.675], lobovsky_checks)
+    if "t_star" in columns and any(re.fullmatch(r"H\d_\w+_star", column) for column in columns):
+        return read_lobovsky_levels(table)
     raise ValueError(f"{path}: unknown layout (columns {', '.join(table.columns[:6])} ...): "
                      "expected SPHERIC Test 2 (time, P1..P8, H1..H4) or Lobovsky 2014 (t_star, p1_star, ...)")
+
+
+def read_lobovsky_levels(table):
+    """Lobovsky's levels: one or two series per gauge (H<k>_<series>_star), compared with their mean."""
+    time = table["t_star"].to_numpy() * np.sqrt(LOBOVSKY_DEPTH / GRAVITY)
+    series = pd.DataFrame({"time": time})
+    gauges = {}
+    for column in table.columns:
+        match = re.fullmatch(r"(H\d)_\w+_star", column)
+        if match:
+            gauges.setdefault(match.group(1), []).append(table[column].to_numpy() * LOBOVSKY_DEPTH)
+    scatter = {}
+    for gauge, measured in sorted(gauges.items()):
+        series[gauge] = np.mean(measured, axis=0)
+        if len(measured) == 2:
+            scatter[gauge] = nmae(time, measured[0], time, measured[1], LOBOVSKY_LEVEL_WINDOW)
+    return Experiment("Lobovsky et al. 2014, H = 300 mm, water levels", series, [], sorted(gauges),
+                      [0.4, 0.5, 0.6, 0.8], lobovsky_level_checks, scatter, LOBOVSKY_LEVEL_WINDOW)
 
 
 def read_run(folder):
@@ -145,7 +175,8 @@ def first_peak(t, y, start):
 
 
 def nmae(t_sim, y_sim, t_exp, y_exp, window=NMAE_WINDOW):
-    grid = np.arange(window[0], window[1], PEAK_BIN)
+    """Over the window, cut at the end of the shorter series (no extrapolation)."""
+    grid = np.arange(window[0], min(window[1], t_sim[-1], t_exp[-1]), PEAK_BIN)
     sim = np.interp(grid, t_sim, running_mean(t_sim, y_sim))
     exp = np.interp(grid, t_exp, running_mean(t_exp, y_exp))
     return float(np.mean(np.abs(sim - exp)) / np.mean(np.abs(exp)))
@@ -168,8 +199,11 @@ def compare(experiment, t_run, run, times):
             s, e = window_mean(t_run, y_sim, t), window_mean(t_exp, y_exp, t)
             rows.append((sensor, f"mean@{t:g}", unit, s, e, s / e if e != 0 else float("nan")))
         if level:
-            value = nmae(t_run, y_sim, t_exp, y_exp)
+            value = nmae(t_run, y_sim, t_exp, y_exp, experiment.nmae_window)
             rows.append((sensor, "nmae", "-", value, 0.0, value))
+            if sensor in experiment.scatter:
+                rows.append((sensor, "scatter", "-", float("nan"), experiment.scatter[sensor],
+                             experiment.scatter[sensor]))
         else:
             p_sim, _ = first_peak(t_run, y_sim, a_sim)
             p_exp, _ = first_peak(t_exp, y_exp, a_exp)
@@ -208,6 +242,14 @@ def lobovsky_checks(table, t_run, run):
                            abs(ratio - 1) <= tolerance, f"ratio {ratio:.3f}"))
     ratio = value(table, "p1", "peak")
     checks.append(("p1 first-impact peak within a factor 2", 0.5 <= ratio <= 2.0, f"ratio {ratio:.3f}"))
+    return checks
+
+
+def lobovsky_level_checks(table, t_run, run):
+    checks = []
+    for sensor in ("H1", "H2", "H3", "H4"):
+        error = value(table, sensor, "nmae")
+        checks.append((f"{sensor} NMAE over 0-1.0 s within 10 %", error <= 0.10, f"{100 * error:.1f} %"))
     return checks
 
 

@@ -220,6 +220,8 @@ module scene_description
    !> Gauge kinds (`&gauge kind=`).
    character(len=*), parameter, public :: gauge_pressure = 'pressure'
    character(len=*), parameter, public :: gauge_level = 'level'
+   !> a level that sees only the water standing on the point: spray and falling jets above a gap are not read
+   character(len=*), parameter, public :: gauge_connected_level = 'connected_level'
    character(len=*), parameter, public :: gauge_velocity = 'velocity'
    !> the pressure a wall or structure takes over a patch of its surface, from its constraint's impulse
    character(len=*), parameter, public :: gauge_wall_pressure = 'wall_pressure'
@@ -227,7 +229,7 @@ module scene_description
    !> `&gauge`: a sensor of the fluid at a point, written to gauges.csv (docs/loads.md).
    type, public :: gauge_spec_t
       character(len=name_len) :: name = ''    !< column prefix in gauges.csv (required)
-      character(len=name_len) :: kind = ''    !< 'pressure', 'level' or 'velocity' (required)
+      character(len=name_len) :: kind = ''    !< 'pressure', 'level', 'connected_level', 'velocity' or 'wall_pressure' (required)
       real(rp) :: point(3) = 0.0_rp           !< where it measures, world frame [m] (required)
       !> pressure, velocity: radius of the sphere (disc in 2-D) it averages over; level: half-width of the
       !> column it looks in [m]; 0: resolved to the cell size (pressure, velocity) or half of it (level)

@@ -11,7 +11,7 @@ module scene_validation
                                 has_velocity_file, motion_spec_t, structure_shape, &
                                 wall_slip, wall_no_slip, wall_friction, motion_none, motion_solitary_wave, motion_table, &
                                 model_newtonian_fluid, model_linear_elastic, model_rigid, gauge_pressure, gauge_level, &
-                                gauge_velocity, gauge_wall_pressure, &
+                                gauge_connected_level, gauge_velocity, gauge_wall_pressure, &
                                 particle_field_names, field_precision_keywords
    use input_text, only: int_text, real_text, quoted_list, group_context, ordinal
    use memory_budget, only: memory_budget_t, byte_text
@@ -73,7 +73,7 @@ module scene_validation
       [character(len=15) :: model_newtonian_fluid, model_linear_elastic, model_rigid]
    !> Accepted `&gauge kind=` keywords (stored lower case).
    character(len=*), parameter, public :: gauge_kind_keywords(*) = &
-      [character(len=13) :: gauge_pressure, gauge_level, gauge_velocity, gauge_wall_pressure]
+      [character(len=15) :: gauge_pressure, gauge_level, gauge_connected_level, gauge_velocity, gauge_wall_pressure]
 
    !> Relative tolerance of "extent is a whole multiple of cell_size".
    real(rp), parameter :: multiple_tolerance = 1.0e-9_rp
@@ -437,7 +437,9 @@ contains
       if (.not. allocated(scene%gauges)) allocate (scene%gauges(0))
       do g = 1, size(scene%gauges)
          associate (gauge => scene%gauges(g))
-            ! Validated >= 0, so not > 0 means 0: one cell, a level gauge's column half a cell either side.
+            ! Validated >= 0, so not > 0 means 0: one cell, a level gauge's column half a cell either side
+            ! (a connected level's one cell: a narrower column can miss the particles of a whole layer as
+            ! they stream past, a gap it would not bridge).
             if (.not. gauge%radius > 0.0_rp) then
                if (gauge%kind == gauge_level .or. gauge%kind == gauge_wall_pressure) then
                   gauge%radius = 0.5_rp * scene%grid%cell_size

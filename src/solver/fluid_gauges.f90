@@ -13,6 +13,13 @@
 !>             column of half-width `radius` through the point, the highest top of a fluid particle
 !>             (centre + half its size (m / rho)^(1/dim) along the vertical) minus the point's
 !>             elevation, at least 0. Vertical is -g, or +y (2-D) / +z (3-D) without gravity.
+!>   connected_level  the top of the water standing on the point, as a resistance wave gauge reads it:
+!>             the same column, cut into bins of half a cell along the vertical from the point; a bin is
+!>             wet where a particle's vertical extent (centre +- half its size) reaches into it, and the
+!>             reading is the highest top among the particles of the wet bins reached from the point
+!>             upward across gaps of up to one cell. Spray, droplets and a jet falling over the gauge above
+!>             a larger gap are not read (`level` reads them); 0 where no water is within a cell above the
+!>             point.
 !>   wall_pressure  the mean pressure the wall `wall` takes over a patch of its surface about the point
 !>             (half-size `radius`), from its constraint's impulse over the row's interval (wall_pressure_taps,
 !>             wall_loads): the load the wall feels, not the particles' pressure next to it, which the
@@ -23,7 +30,8 @@ module fluid_gauges
    use kinds, only: rp, name_len
    use communication_counters, only: count_collective, comm_records, real_bytes
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_SUM, MPI_MAX
-   use scene_description, only: scene_t, gauge_pressure, gauge_level, gauge_velocity, gauge_wall_pressure
+   use scene_description, only: scene_t, gauge_pressure, gauge_level, gauge_connected_level, gauge_velocity, &
+                                gauge_wall_pressure
    use material_model, only: material_slot_t
    use particle_set, only: particle_set_t
    use tensor_layout, only: mean_stress
@@ -33,6 +41,8 @@ module fluid_gauges
 
    !> Below this spread (standard deviation along a principal direction, in radii) the plane is not fitted.
    real(rp), parameter :: min_spread = 0.1_rp
+   !> connected_level: bins per cell along the vertical, and the empty bins bridged (one cell).
+   integer, parameter :: bins_per_cell = 2, bridged_bins = bins_per_cell
 
    type :: gauge_t
       character(len=name_len) :: name = ''
@@ -41,6 +51,8 @@ module fluid_gauges
       real(rp) :: radius = 0.0_rp
       integer :: first_sum = 0, first_max = 0  !< where its partial sums / maxima start in the packed arrays
       integer :: slot = 0                      !< wall_pressure: its index among the wall-pressure gauges
+      integer :: bins = 0                      !< connected_level: bins of the column (its maxima)
+      real(rp) :: bin = 0.0_rp                 !< connected_level: their height [m]
    end type gauge_t
 
    type, public :: fluid_gauges_t
@@ -93,6 +105,12 @@ contains
             case (gauge_level)
                self%n_sums = self%n_sums + 1          ! particles in the column
                self%n_max = self%n_max + 1            ! highest top
+            case (gauge_connected_level)
+               ! bins from the point up to the far corner of the grid box, each holding its highest top
+               gauge%bin = scene%grid%cell_size / bins_per_cell
+               gauge%bins = ceiling(norm2(scene%grid%extent(1:d)) / gauge%bin) + 1
+               self%n_sums = self%n_sums + 1
+               self%n_max = self%n_max + gauge%bins
             case (gauge_wall_pressure)
                slots = slots + 1                      ! read from the wall's impulse, no particle sums
                gauge%slot = slots
@@ -150,13 +168,18 @@ contains
                   if (gauge%kind == gauge_wall_pressure) cycle
                   dx = particles%x(:, p) - gauge%point(1:d)
                   m = particles%mass(p)
-                  if (gauge%kind == gauge_level) then
+                  if (gauge%kind == gauge_level .or. gauge%kind == gauge_connected_level) then
                      rise = dot_product(dx, self%up(1:d))
                      across = dx - rise * self%up(1:d)
                      if (dot_product(across, across) > gauge%radius**2) cycle
                      size_p = (m / particles%density(p))**(1.0_rp / d)
                      sums(gauge%first_sum) = sums(gauge%first_sum) + 1.0_rp
-                     maxima(gauge%first_max) = max(maxima(gauge%first_max), rise + 0.5_rp * size_p)
+                     if (gauge%kind == gauge_level) then
+                        maxima(gauge%first_max) = max(maxima(gauge%first_max), rise + 0.5_rp * size_p)
+                     else
+                        call mark_bins(maxima(gauge%first_max:gauge%first_max + gauge%bins - 1), gauge%bin, &
+                                       rise - 0.5_rp * size_p, rise + 0.5_rp * size_p)
+                     end if
                      cycle
                   end if
                   if (dot_product(dx, dx) > gauge%radius**2) cycle
@@ -200,6 +223,9 @@ contains
                rise = 0.0_rp
                if (n_seen > 0.0_rp) rise = max(0.0_rp, maxima(gauge%first_max))
                values = [values, rise, n_seen]
+            case (gauge_connected_level)
+               values = [values, connected_top(maxima(gauge%first_max:gauge%first_max + gauge%bins - 1)), &
+                         sums(gauge%first_sum)]
             case (gauge_pressure)
                values = [values, fitted_values(sums(gauge%first_sum:gauge%first_sum + fit_width(d, 1) - 1), d, 1, &
                                                gauge%radius), sums(gauge%first_sum)]
@@ -295,7 +321,7 @@ contains
                cycle
             case (gauge_pressure)
                columns(n + 1) = trim(name)//'_pressure'
-            case (gauge_level)
+            case (gauge_level, gauge_connected_level)
                columns(n + 1) = trim(name)//'_level'
             case default
                do k = 1, self%dim
@@ -307,6 +333,38 @@ contains
          end associate
       end do
    end function gauges_column_names
+
+   !> connected_level: a particle reaching from `bottom` to `top` above the point wets the bins it
+   !> overlaps; each keeps the highest top of the particles that wet it (-huge: dry).
+   pure subroutine mark_bins(tops, bin, bottom, top)
+      real(rp), intent(inout) :: tops(0:)
+      real(rp), intent(in) :: bin, bottom, top
+      integer :: first, last
+      if (top < 0.0_rp) return
+      first = max(0, floor(bottom / bin))
+      last = min(ubound(tops, 1), floor(top / bin))
+      if (first > last) return
+      tops(first:last) = max(tops(first:last), top)
+   end subroutine mark_bins
+
+   !> connected_level: the highest top among the wet bins reached from the point (bin 0) upward across
+   !> gaps of at most `bridged_bins` dry bins (also the first: a floor particle may sit a little above
+   !> the floor); 0 when none is reached.
+   pure real(rp) function connected_top(tops) result(top)
+      real(rp), intent(in) :: tops(0:)
+      integer :: b, dry
+      top = 0.0_rp
+      dry = 0
+      do b = 0, ubound(tops, 1)
+         if (tops(b) > -0.5_rp * huge(1.0_rp)) then
+            top = max(top, tops(b))
+            dry = 0
+         else
+            dry = dry + 1
+            if (dry > bridged_bins) exit
+         end if
+      end do
+   end function connected_top
 
    !> Columns of gauges.csv of a gauge of `kind`: its value(s) and the particles it saw; a wall pressure alone.
    pure integer function column_count(kind, dim)

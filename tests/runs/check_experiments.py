@@ -27,14 +27,16 @@ import time
 
 from flotsam_run import Checks, Flotsam
 
+# scene, measured data sets it is compared with
 CASES = {
-    "lobovsky": ("inputs/validation/lobovsky_h300.nml", "tests/data/experiments/lobovsky2014_h300_pressure.csv"),
-    "spheric": ("inputs/validation/spheric_test2.nml", "tests/data/experiments/spheric_test2_kleefsman2005.csv"),
+    "lobovsky": ("inputs/validation/lobovsky_h300.nml", ["tests/data/experiments/lobovsky2014_h300_pressure.csv",
+                                                         "tests/data/experiments/lobovsky2014_h300_levels.csv"]),
+    "spheric": ("inputs/validation/spheric_test2.nml", ["tests/data/experiments/spheric_test2_kleefsman2005.csv"]),
 }
 
 
 def run_case(checks, flotsam, root, name, ranks, figures):
-    scene, data = (os.path.join(root, part) for part in CASES[name])
+    scene = os.path.join(root, CASES[name][0])
     output = f"experiment_{name}"
     flotsam.remove(output)
     path = flotsam.scene(scene, f"{name}.nml", output, particle_output=".false.")
@@ -43,16 +45,19 @@ def run_case(checks, flotsam, root, name, ranks, figures):
     seconds = time.time() - started
     if not checks.check(result.returncode == 0, f"{name}: run on {ranks} ranks ({seconds:.0f} s)", result.stderr[-2000:]):
         return
-    compare = [sys.executable, os.path.join(root, "scripts", "compare_experiment.py"), flotsam.path(output), data,
-               "--check", "--csv", os.path.join(figures, f"experiment_{name}.csv"),
-               "--plot", os.path.join(figures, f"experiment_{name}.png")]
-    report = subprocess.run(compare, capture_output=True, text=True)
-    print(report.stdout, end="", flush=True)
-    verdicts = [line for line in report.stdout.splitlines() if line.startswith(("PASS: ", "FAIL: "))]
-    checks.check(report.returncode in (0, 1) and verdicts, f"{name}: compare_experiment.py ran", report.stderr[-2000:])
-    for line in verdicts:
-        verdict, _, text = line.partition(": ")
-        checks.check(verdict == "PASS", f"{name}: {text}")
+    for data in CASES[name][1]:
+        stem = os.path.splitext(os.path.basename(data))[0]
+        compare = [sys.executable, os.path.join(root, "scripts", "compare_experiment.py"), flotsam.path(output),
+                   os.path.join(root, data), "--check", "--csv", os.path.join(figures, f"experiment_{stem}.csv"),
+                   "--plot", os.path.join(figures, f"experiment_{stem}.png")]
+        report = subprocess.run(compare, capture_output=True, text=True)
+        print(report.stdout, end="", flush=True)
+        verdicts = [line for line in report.stdout.splitlines() if line.startswith(("PASS: ", "FAIL: "))]
+        checks.check(report.returncode in (0, 1) and verdicts, f"{name}: compare_experiment.py against {stem} ran",
+                     report.stderr[-2000:])
+        for line in verdicts:
+            verdict, _, text = line.partition(": ")
+            checks.check(verdict == "PASS", f"{name}: {text}")
 
 
 RESERVOIR = dict(scene="inputs/validation/spheric_test2_slice_2d.nml", tolerance=0.025, window=(0.0, 1.0),
@@ -63,7 +68,7 @@ def check_reservoir(checks, flotsam, root, ranks):
     """The reservoir's level H4 of the 2-D slice against the measured, recommended settings and multilinear."""
     sys.path.insert(0, os.path.join(root, "scripts"))
     import compare_experiment
-    experiment = compare_experiment.read_experiment(os.path.join(root, CASES["spheric"][1]))
+    experiment = compare_experiment.read_experiment(os.path.join(root, CASES["spheric"][1][0]))
     t_exp = experiment.series["time"].to_numpy()
     for cell in RESERVOIR["cells"]:
         for shape in ("bspline2", "linear"):

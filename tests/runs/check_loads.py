@@ -364,7 +364,7 @@ EXPECTED_COLUMNS = {
     "loads": ["time"] + [f"{wall}_{c}" for wall in ["wall_1", "x_min", "tank_right", "y_min"]
                          for c in ["fx", "fy", "mz"]],
     "gauges": ["time", "p_left_pressure", "p_left_samples", "level_mid_level", "level_mid_samples", "v_front_vx",
-               "v_front_vy", "v_front_samples"],
+               "v_front_vy", "v_front_samples", "p_back_pressure", "p_wall_1_pressure"],
     "bodies": ["time"] + [f"body_2_{c}" for c in ["x", "y", "vx", "vy", "angle", "fx", "fy"]],
 }
 

@@ -13,6 +13,7 @@ module test_impact_loads
    use assertions, only: assertTrue, assertEqual, assertRelativelyEqual
    use error_status, only: status_t
    use scene_description, only: scene_t, gauge_spec_t, wall_none, gauge_pressure, gauge_level, gauge_velocity, &
+                                gauge_connected_level, &
                                 model_linear_elastic
    use mpm_solver, only: solver_t
    use body_motion, only: body_state_t
@@ -22,7 +23,8 @@ module test_impact_loads
    private
 
    public :: test_hydrostatic_wall_loads_2d, test_hydrostatic_wall_loads_3d, test_wall_impulses_balance_momentum, &
-             test_gauges_read_linear_fields, test_rigid_body_motion_2d, test_rigid_body_motion_3d
+             test_gauges_read_linear_fields, test_connected_level_ignores_spray, &
+             test_rigid_body_motion_2d, test_rigid_body_motion_3d
 
    real(rp), parameter :: rho = 1000.0_rp, g = 9.81_rp
 
@@ -181,6 +183,44 @@ contains
       call assertTrue(values(10) == 0.0_rp .and. values(11) == 0.0_rp, 'a dry gauge reads 0 with 0 samples')
       call solver%free()
    end subroutine test_gauges_read_linear_fields
+
+   !> A level gauge reads the highest fluid in its column, a connected_level gauge the water standing on
+   !> its point: a blob a few centimetres above the surface (a gap under one cell) counts, spray 0.3 m
+   !> above it does not. Tank of 0.6 m at h = 0.1 m (particles 0.05 m), the gauges' column x = 0.95-1.05.
+   subroutine test_connected_level_ignores_spray(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(scene_t) :: scene
+      type(solver_t) :: solver
+      type(status_t) :: status
+      real(rp), allocatable :: values(:)
+      integer :: i
+      scene = water_scene(2, 0.1_rp, [2.0_rp, 1.0_rp, 0.0_rp], 2.0e6_rp, g)
+      call add_body(scene, 1, [0.0_rp, 0.0_rp, 0.0_rp], [2.0_rp, 0.6_rp, 0.0_rp], 2, .false., 0.0_rp)
+      allocate (scene%gauges(3))
+      scene%gauges(1) = gauge_spec_t(name='top', kind=gauge_level, point=[1.0_rp, 0.0_rp, 0.0_rp], radius=0.05_rp)
+      scene%gauges(2) = gauge_spec_t(name='wire', kind=gauge_connected_level, point=[1.0_rp, 0.0_rp, 0.0_rp], &
+                                     radius=0.05_rp)
+      scene%gauges(3) = gauge_spec_t(name='dry', kind=gauge_connected_level, point=[1.0_rp, 0.75_rp, 0.0_rp], &
+                                     radius=0.05_rp)
+      call solver%init(scene, comm, status)
+      call assertTrue(status%ok, 'spray scene: '//trim(status%message))
+      ! of the column's two particles per row, move one of the top row up as spray (0.925-0.975 m) and
+      ! one of the row below to a blob just above the surface (0.635-0.685 m); the other keeps each row wet
+      do i = 1, solver%particles%count
+         associate (x => solver%particles%x(:, i))
+            if (abs(x(1) - 0.975_rp) < 1.0e-6_rp .and. abs(x(2) - 0.575_rp) < 1.0e-6_rp) x(2) = 0.95_rp
+            if (abs(x(1) - 1.025_rp) < 1.0e-6_rp .and. abs(x(2) - 0.525_rp) < 1.0e-6_rp) x(2) = 0.66_rp
+         end associate
+      end do
+      values = solver%gauges%sample(solver%particles, solver%materials, solver%grid%frame, solver%domain%comm, &
+                                    solver%loads%sensor_pressure)
+      call assertEqual(6, size(values), 'level and samples of each gauge')
+      call assertRelativelyEqual(0.975_rp, values(1), 1.0e-12_rp, 'level: the spray particle''s top')
+      call assertRelativelyEqual(0.685_rp, values(3), 1.0e-12_rp, 'connected_level: the blob''s top, not the spray')
+      call assertEqual(values(2), values(4), 'both saw the same particles')
+      call assertTrue(values(5) == 0.0_rp, 'connected_level: 0 with no water within a cell above its point')
+      call solver%free()
+   end subroutine test_connected_level_ignores_spray
 
    !> A scene with one solid block (and no fluid body) for the body measurements.
    function block_scene(dim) result(scene)
