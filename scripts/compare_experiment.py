@@ -69,6 +69,7 @@ PEAK_BIN = 0.001               # s: the bins both series are averaged over befor
 PEAK_SEARCH = 0.050            # s after the arrival in which the first-impact peak is taken
 NMAE_WINDOW = (0.0, 1.5)       # s
 LOBOVSKY_LEVEL_WINDOW = (0.0, 1.0)   # s: the scene's length (the reflected bore comes back after it)
+LEVEL_COLUMN = re.compile(r"(H\d)_\w+_star")   # Lobovsky's levels: gauge, then the series' label
 
 
 class Experiment:
@@ -103,7 +104,7 @@ def read_experiment(path):
                 pressures.append(name)
         return Experiment("Lobovsky et al. 2014, H = 300 mm", series, pressures, [],
                           [0.475, 0.525, 0.575, 0.625, 0.675], lobovsky_checks)
-    if "t_star" in columns and any(re.fullmatch(r"H\d_\w+_star", column) for column in columns):
+    if "t_star" in columns and any(LEVEL_COLUMN.fullmatch(column) for column in columns):
         return read_lobovsky_levels(table)
     raise ValueError(f"{path}: unknown layout (columns {', '.join(table.columns[:6])} ...): "
                      "expected SPHERIC Test 2 (time, P1..P8, H1..H4) or Lobovsky 2014 (t_star, p1_star, ...)")
@@ -115,7 +116,7 @@ def read_lobovsky_levels(table):
     series = pd.DataFrame({"time": time})
     gauges = {}
     for column in table.columns:
-        match = re.fullmatch(r"(H\d)_\w+_star", column)
+        match = LEVEL_COLUMN.fullmatch(column)
         if match:
             gauges.setdefault(match.group(1), []).append(table[column].to_numpy() * LOBOVSKY_DEPTH)
     scatter = {}
@@ -223,9 +224,7 @@ def spheric_checks(table, t_run, run):
         for t in (0.5, 0.6, 0.8, 1.0):
             ratio = value(table, sensor, f"mean@{t:g}")
             checks.append((f"{sensor} 10 ms mean at {t:g} s within 20 %", abs(ratio - 1) <= 0.2, f"ratio {ratio:.3f}"))
-    for sensor in ("H2", "H4"):
-        error = value(table, sensor, "nmae")
-        checks.append((f"{sensor} NMAE over 0-1.5 s within 10 %", error <= 0.10, f"{100 * error:.1f} %"))
+    checks += level_checks(table, ("H2", "H4"), "0-1.5 s")
     if "P7" in run:
         before = t_run < 1.0
         top = float(np.max(running_mean(t_run, run["P7"])[before])) if before.any() else float("nan")
@@ -245,12 +244,17 @@ def lobovsky_checks(table, t_run, run):
     return checks
 
 
-def lobovsky_level_checks(table, t_run, run):
+def level_checks(table, sensors, window):
+    """Each level's NMAE within 10 % (the bound of both experiments' levels)."""
     checks = []
-    for sensor in ("H1", "H2", "H3", "H4"):
+    for sensor in sensors:
         error = value(table, sensor, "nmae")
-        checks.append((f"{sensor} NMAE over 0-1.0 s within 10 %", error <= 0.10, f"{100 * error:.1f} %"))
+        checks.append((f"{sensor} NMAE over {window} within 10 %", error <= 0.10, f"{100 * error:.1f} %"))
     return checks
+
+
+def lobovsky_level_checks(table, t_run, run):
+    return level_checks(table, ("H1", "H2", "H3", "H4"), "0-1.0 s")
 
 
 def plot(experiment, t_run, run, path, label):

@@ -107,6 +107,8 @@ def main():
     for name in arguments.cases:
         case = SCENES[name]
         experiment = compare_experiment.read_experiment(os.path.join(ROOT, case["data"]))
+        measured_levels = (compare_experiment.read_experiment(os.path.join(ROOT, case["levels"]))
+                           if "levels" in case else None)
         cells = [float(c) for c in arguments.cells.split(",")] if arguments.cells else case["cells"]
         rows = []
         for setting in arguments.settings.split(","):
@@ -116,10 +118,8 @@ def main():
                 t_run, values = compare_experiment.read_run(output)
                 table = compare_experiment.compare(experiment, t_run, values, experiment.times)
                 table.to_csv(output + "_comparison.csv", index=False)
-                levels = None
-                if "levels" in case:
-                    measured = compare_experiment.read_experiment(os.path.join(ROOT, case["levels"]))
-                    levels = compare_experiment.compare(measured, t_run, values, measured.times)
+                levels = (compare_experiment.compare(measured_levels, t_run, values, measured_levels.times)
+                          if measured_levels else None)
                 wall, steps = run_facts(output)
                 rows.append((setting, cell, errors(name, experiment, table, levels), wall, steps))
         keys = list(rows[0][2])
