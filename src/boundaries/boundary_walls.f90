@@ -36,6 +36,7 @@ module boundary_walls
    use wall_motion, only: wall_motion_t, prescribed_motion
    use time_table, only: time_table_t
    use wall_pressure_taps, only: pressure_taps_t, wall_sensor_t, tangent_axes
+   use load_entries, only: load_entry_t, entry_of, entry_wall, entry_box_side, entry_structure
    implicit none
    private
 
@@ -108,20 +109,21 @@ contains
       if (grid%ghost > 0) depth = max(depth_in_cells, 1.5_rp * sqrt(real(grid%dim, rp)))
    end function wall_depth_in_cells
 
-   !> The walls of `&wall` groups (`specs`) and of the `&box_walls` sides of `spec`, with their local nodes.
-   !> With `gravity` (world frame) and `time`, a `&wall` with a motion moves (the solitary stroke needs g)
-   !> and is placed where it is at `time`.
-   subroutine build_walls(specs, spec, grid, walls, gravity, time, tables)
+   !> The walls of `&wall` groups (`specs`) and of the `&box_walls` sides of `spec`, with their local nodes,
+   !> each reporting to its entry of loads.csv (`entries`, load_entries). With `gravity` (world frame) and
+   !> `time`, a `&wall` with a motion moves (the solitary stroke needs g) and is placed where it is at `time`.
+   subroutine build_walls(specs, spec, grid, entries, walls, gravity, time, tables)
       type(wall_spec_t), intent(in) :: specs(:)
       type(grid_spec_t), intent(in) :: spec
       type(grid_t), intent(in) :: grid
+      type(load_entry_t), intent(in) :: entries(:)
       type(wall_t), allocatable, intent(out) :: walls(:)
       real(rp), intent(in), optional :: gravity(3), time
       type(time_table_t), intent(in), optional :: tables(:)   !< per spec, the table of a 'table' motion
       type(wall_spec_t), allocatable :: all_specs(:)
       integer :: w
       all_specs = [specs, box_side_walls(spec)]
-      call build_walls_of(all_specs, grid, walls)
+      call build_walls_of(all_specs, size(specs), grid, entries, walls)
       if (.not. (present(gravity) .and. present(time))) return
       do w = 1, size(specs)
          if (present(tables)) then
@@ -139,16 +141,24 @@ contains
       call refresh_moving_walls(walls, grid)
    end subroutine build_walls
 
-   subroutine build_walls_of(specs, grid, walls)
+   !> specs: the n_walls &wall groups, then the box sides (box_side_walls' order is the entries' order).
+   subroutine build_walls_of(specs, n_walls, grid, entries, walls)
       type(wall_spec_t), intent(in) :: specs(:)
+      integer, intent(in) :: n_walls
       type(grid_t), intent(in) :: grid
+      type(load_entry_t), intent(in) :: entries(:)
       type(wall_t), allocatable, intent(out) :: walls(:)
-      integer :: w, kind
+      integer :: w, kind, load
       allocate (walls(size(specs)))
       do w = 1, size(specs)
          kind = condition_kind(specs(w)%condition)
+         if (w <= n_walls) then
+            load = entry_of(entries, entry_wall, w)
+         else
+            load = entry_of(entries, entry_box_side, w - n_walls)
+         end if
          walls(w) = make_wall(grid, specs(w)%point, specs(w)%normal, specs(w)%lower, specs(w)%upper, grid%h, kind, &
-                              load=w, moment_point=specs(w)%moment_point)
+                              load=load, moment_point=specs(w)%moment_point)
          walls(w)%friction = specs(w)%friction
       end do
    end subroutine build_walls_of
@@ -278,13 +288,13 @@ contains
       if (condition == wall_friction) kind = wall_kind_friction
    end function condition_kind
 
-   !> The structures of `&structure` groups appended to `walls`; structure s reports to loads.csv entry
-   !> first_load + s. With `gravity` (world frame) and `time`, a structure with a motion moves and is
+   !> The structures of `&structure` groups appended to `walls`; each reports to its entry of loads.csv
+   !> (`entries`). With `gravity` (world frame) and `time`, a structure with a motion moves and is
    !> placed where it is at `time` (`tables`: per spec, the table of a 'table' motion).
-   subroutine build_structures(specs, grid, first_load, walls, gravity, time, tables)
+   subroutine build_structures(specs, grid, entries, walls, gravity, time, tables)
       type(structure_spec_t), intent(in) :: specs(:)
       type(grid_t), intent(in) :: grid
-      integer, intent(in) :: first_load
+      type(load_entry_t), intent(in) :: entries(:)
       type(wall_t), allocatable, intent(inout) :: walls(:)
       real(rp), intent(in), optional :: gravity(3), time
       type(time_table_t), intent(in), optional :: tables(:)
@@ -293,7 +303,7 @@ contains
       allocate (structures(size(specs)))
       do s = 1, size(specs)
          structures(s) = make_structure(grid, specs(s)%shape, condition_kind(specs(s)%condition), specs(s)%friction, &
-                                        first_load + s, specs(s)%moment_point)
+                                        entry_of(entries, entry_structure, s), specs(s)%moment_point)
          if (.not. (present(gravity) .and. present(time))) cycle
          if (present(tables)) then
             structures(s)%motion = prescribed_motion(specs(s)%motion, specs(s)%motion%direction, gravity, grid%dim, &

@@ -31,6 +31,7 @@ module fluid_inflow
    use domain_decomposition, only: domain_t
    use particle_set, only: particle_set_t
    use boundary_walls, only: wall_t, make_wall, wall_kind_slip, wall_kind_prescribed
+   use load_entries, only: load_entry_t, entry_of, entry_inlet
    use newtonian_fluid, only: eos_density
    implicit none
    private
@@ -73,18 +74,18 @@ contains
 
    !> The scene's inlets, and their walls appended to `walls` (after the scene's walls, so that the
    !> feeder's prescribed velocity wins where they meet). first_id: the first id after the bodies'. The
-   !> walls of inlet i report to load entry n + i, n the number of walls before them (the loads.csv order).
-   subroutine build_inlets(scene, grid, first_id, inlets, walls)
+   !> walls of inlet i report to its entry of loads.csv (`entries`, load_entries).
+   subroutine build_inlets(scene, grid, first_id, entries, inlets, walls)
       type(scene_t), intent(in) :: scene
       type(grid_t), intent(in) :: grid
       integer(i8), intent(in) :: first_id
+      type(load_entry_t), intent(in) :: entries(:)
       type(inlet_t), allocatable, intent(out) :: inlets(:)
       type(wall_t), allocatable, intent(inout) :: walls(:)
       integer :: i, dim, load
       real(rp) :: far_end(3), lower(3), upper(3), margin, volume_across
 
       dim = scene%grid%dim
-      load = size(walls)
       if (.not. allocated(scene%inlets)) then
          allocate (inlets(0))
          return
@@ -121,7 +122,7 @@ contains
             lower = min(spec%point, far_end)
             upper = max(spec%point, far_end)
             margin = opening_margin * scene%grid%cell_size
-            load = load + 1
+            load = entry_of(entries, entry_inlet, i)
             inlet%feeder = size(walls) + 1
             walls = [walls, make_wall(grid, spec%point, spec%direction, lower, upper, margin, wall_kind_prescribed, &
                                       velocity=spec%velocity * spec%direction, active_from=spec%start_time, &

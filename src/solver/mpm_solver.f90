@@ -39,7 +39,7 @@ module mpm_solver
    use c0_anti_locking, only: c0_anti_locking_t
    use volume_correction, only: volume_corrector_t, max_shift_in_cells
    use boundary_walls, only: wall_t, build_walls, build_structures, set_wall_activity, apply_wall_constraints, &
-                             keep_particles_inside, first_particle_inside, box_side_walls, wall_distance, move_walls, &
+                             keep_particles_inside, first_particle_inside, wall_distance, move_walls, &
                              place_moving_walls, moving_wall_speed, attach_wall_sensors
    use fluid_inflow, only: inlet_t, build_inlets
    use wall_loads, only: wall_loads_t
@@ -284,30 +284,30 @@ contains
    subroutine build_walls_and_structures(self)
       type(solver_t), intent(inout) :: self
       type(wall_spec_t), allocatable :: no_walls(:)
-      integer :: entries
-      if (allocated(self%scene%walls)) then
-         if (allocated(self%scene%wall_tables)) then
-            call build_walls(self%scene%walls, self%scene%grid, self%grid, self%walls, self%scene%gravity, self%time, &
-                             self%scene%wall_tables)
+      ! each surface reports to its entry of loads.csv (load_entries, via self%loads)
+      associate (entries => self%loads%entries)
+         if (allocated(self%scene%walls)) then
+            if (allocated(self%scene%wall_tables)) then
+               call build_walls(self%scene%walls, self%scene%grid, self%grid, entries, self%walls, self%scene%gravity, &
+                                self%time, self%scene%wall_tables)
+            else
+               call build_walls(self%scene%walls, self%scene%grid, self%grid, entries, self%walls, self%scene%gravity, &
+                                self%time)
+            end if
          else
-            call build_walls(self%scene%walls, self%scene%grid, self%grid, self%walls, self%scene%gravity, self%time)
+            allocate (no_walls(0))
+            call build_walls(no_walls, self%scene%grid, self%grid, entries, self%walls)
          end if
-      else
-         allocate (no_walls(0))
-         call build_walls(no_walls, self%scene%grid, self%grid, self%walls)
-      end if
-      ! inlet ids start after every id of the bodies (their whole lattices, not just the particles kept)
-      call build_inlets(self%scene, self%grid, scene_id_count(self%scene), self%inlets, self%walls)
-      if (.not. allocated(self%scene%structures)) return
-      ! loads.csv entries before the structures: the &wall groups, the box sides, the inlets
-      entries = size(box_side_walls(self%scene%grid)) + size(self%inlets)
-      if (allocated(self%scene%walls)) entries = entries + size(self%scene%walls)
-      if (allocated(self%scene%structure_tables)) then
-         call build_structures(self%scene%structures, self%grid, entries, self%walls, self%scene%gravity, self%time, &
-                               self%scene%structure_tables)
-      else
-         call build_structures(self%scene%structures, self%grid, entries, self%walls, self%scene%gravity, self%time)
-      end if
+         ! inlet ids start after every id of the bodies (their whole lattices, not just the particles kept)
+         call build_inlets(self%scene, self%grid, scene_id_count(self%scene), entries, self%inlets, self%walls)
+         if (.not. allocated(self%scene%structures)) return
+         if (allocated(self%scene%structure_tables)) then
+            call build_structures(self%scene%structures, self%grid, entries, self%walls, self%scene%gravity, &
+                                  self%time, self%scene%structure_tables)
+         else
+            call build_structures(self%scene%structures, self%grid, entries, self%walls, self%scene%gravity, self%time)
+         end if
+      end associate
    end subroutine build_walls_and_structures
 
    !> A structure displaces the fluid: the particles of fluid bodies seeded inside it (phi < 0) are not

@@ -18,8 +18,9 @@ module wall_loads
    use kinds, only: rp, name_len
    use communication_counters, only: count_collective, comm_records, real_bytes
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_SUM
-   use scene_description, only: scene_t, wall_spec_t, gauge_wall_pressure
-   use boundary_walls, only: wall_t, impulse_rows, box_side_walls
+   use scene_description, only: scene_t, gauge_wall_pressure
+   use boundary_walls, only: wall_t, impulse_rows
+   use load_entries, only: load_entry_t, scene_load_entries, entries_before, entry_structure
    use body_contact, only: contact_body_names
    use world_frame, only: frame_t
    implicit none
@@ -27,7 +28,9 @@ module wall_loads
 
    type, public :: wall_loads_t
       integer :: dim = 2
-      !> one entry per wall, box side, inlet and structure, then per structure and body field
+      !> the scene's surfaces in loads.csv order (load_entries)
+      type(load_entry_t), allocatable :: entries(:)
+      !> one name per entry, then per structure and body field
       character(len=2 * name_len + 4), allocatable :: names(:)
       real(rp), allocatable :: step_impulse(:, :)        !< (impulse_rows, wall) this rank, this step
       integer :: fields = 0                              !< contact body fields
@@ -52,32 +55,23 @@ module wall_loads
 
 contains
 
-   !> The entries of the scene in loads.csv order: the &wall groups, the &box_walls sides that are walls,
-   !> the &inlet groups, the &structure groups (the order of the walls boundary_walls and fluid_inflow
-   !> build, section 3).
+   !> The entries of the scene in loads.csv order (load_entries: the &wall groups, the &box_walls sides
+   !> that are walls, the &inlet groups, the &structure groups), then per structure and contact body field.
    subroutine loads_init(self, scene)
       class(wall_loads_t), intent(inout) :: self
       type(scene_t), intent(in) :: scene
-      type(wall_spec_t), allocatable :: sides(:)
       character(len=name_len), allocatable :: bodies(:)
       character(len=2 * name_len + 4) :: entry
-      integer :: n_walls, n_inlets, n_structures, before, s, f
+      integer :: n_structures, e, s, f
       self%dim = scene%grid%dim
-      sides = box_side_walls(scene%grid)
-      n_walls = 0
-      if (allocated(scene%walls)) n_walls = size(scene%walls)
-      n_inlets = 0
-      if (allocated(scene%inlets)) n_inlets = size(scene%inlets)
+      self%entries = scene_load_entries(scene)
+      allocate (self%names(size(self%entries)))
+      do e = 1, size(self%entries)
+         self%names(e) = self%entries(e)%name
+      end do
       n_structures = 0
       if (allocated(scene%structures)) n_structures = size(scene%structures)
-      allocate (self%names(n_walls + size(sides) + n_inlets + n_structures))
-      if (n_walls > 0) self%names(1:n_walls) = scene%walls%name
-      if (size(sides) > 0) self%names(n_walls + 1:n_walls + size(sides)) = sides%name
-      before = n_walls + size(sides)
-      if (n_inlets > 0) self%names(before + 1:before + n_inlets) = scene%inlets%name
-      before = before + n_inlets
-      if (n_structures > 0) self%names(before + 1:) = scene%structures%name
-      self%first_structure = before
+      self%first_structure = entries_before(self%entries, entry_structure)
       self%structures = n_structures
       ! the entries per structure and body field: only with contact fields, so other scenes keep their columns
       bodies = contact_body_names(scene)
