@@ -1,5 +1,5 @@
 !> The entries of loads.csv, in their order: the one place that order is decided (docs/output.md,
-!> "loads.csv"). Each surface that takes load from the material is one entry, named as the scene names
+!> "Loads, gauges and bodies"). Each surface that takes load from the material is one entry, named as the scene names
 !> it: the `&wall` groups, the `&box_walls` sides that are walls (x_min, x_max, y_min, ... in that order),
 !> the `&inlet` groups (an inlet's feeder and its closing walls are one entry), the `&structure` groups.
 !> The walls and structures built from the scene (boundary_walls, fluid_inflow) take their entry from
