@@ -29,14 +29,14 @@
 !> counted by one of them only (`counted`).
 module boundary_walls
    use kinds, only: rp
-   use scene_description, only: wall_spec_t, grid_spec_t, structure_spec_t, wall_none, wall_no_slip, wall_friction
+   use scene_description, only: wall_spec_t, grid_spec_t, structure_spec_t, wall_no_slip, wall_friction
    use shape_geometry, only: shape_t, shape_distance, shape_normal, shape_bounds, translated_shape
    use background_grid, only: grid_t
    use particle_set, only: particle_set_t
    use wall_motion, only: wall_motion_t, prescribed_motion
    use time_table, only: time_table_t
    use wall_pressure_taps, only: pressure_taps_t, wall_sensor_t, tangent_axes
-   use load_entries, only: load_entry_t, entry_of, entry_wall, entry_box_side, entry_structure
+   use load_entries, only: load_entry_t, entry_of, entry_wall, entry_box_side, entry_structure, box_side_walls
    implicit none
    private
 
@@ -93,7 +93,7 @@ module boundary_walls
    !> Rows of an impulse accumulator (impulse_rows, wall): force impulse (3), then moment impulse (3), grid frame.
    integer, parameter, public :: impulse_rows = 6
 
-   public :: build_walls, box_side_walls, make_wall, make_structure, build_structures, set_wall_activity, &
+   public :: build_walls, make_wall, make_structure, build_structures, set_wall_activity, &
              apply_wall_constraints, keep_particles_inside, behind_wall, wall_distance, unilateral_velocity, &
              first_particle_inside, surface_normal, move_walls, place_moving_walls, moving_wall_speed, &
              attach_wall_sensors
@@ -141,7 +141,7 @@ contains
       call refresh_moving_walls(walls, grid)
    end subroutine build_walls
 
-   !> specs: the n_walls &wall groups, then the box sides (box_side_walls' order is the entries' order).
+   !> specs: the n_walls &wall groups, then the box sides in box_side_walls' order (the entries' order).
    subroutine build_walls_of(specs, n_walls, grid, entries, walls)
       type(wall_spec_t), intent(in) :: specs(:)
       integer, intent(in) :: n_walls
@@ -506,37 +506,6 @@ contains
       foot = grid%frame%world_point(x - wall_distance(wall, grid, x) * wall%normal(1:d))
       in_extent = all(foot >= wall%lower(1:d) - wall%margin) .and. all(foot <= wall%upper(1:d) + wall%margin)
    end function in_extent
-
-   !> The sides of the scene box that `&box_walls` makes walls, as `&wall` entries: each is the face of
-   !> the box lower..lower + ncells h (world frame), with the normal pointing into the box.
-   pure function box_side_walls(grid) result(walls)
-      type(grid_spec_t), intent(in) :: grid
-      type(wall_spec_t), allocatable :: walls(:)
-      type(wall_spec_t) :: wall
-      real(rp) :: upper(3)
-      integer :: k, side
-      allocate (walls(0))
-      upper = grid%origin + grid%ncells * grid%cell_size
-      do k = 1, grid%dim
-         do side = 1, 2
-            if (grid%wall(side, k) == wall_none) cycle
-            wall%condition = grid%wall(side, k)
-            wall%friction = grid%wall_friction
-            wall%name = grid%wall_name(side, k)
-            wall%normal = 0.0_rp
-            wall%normal(k) = merge(1.0_rp, -1.0_rp, side == 1)
-            wall%lower = grid%origin
-            wall%upper = upper
-            wall%point = grid%origin
-            if (side == 2) wall%point(k) = upper(k)
-            wall%lower(k) = wall%point(k)
-            wall%upper(k) = wall%point(k)
-            ! the moment of a box side is taken about its lower corner
-            wall%moment_point = wall%point
-            walls = [walls, wall]
-         end do
-      end do
-   end function box_side_walls
 
    !> A wall through the world point `point` with the world unit normal `normal`, its extent lower..upper
    !> (world) widened by `margin`, and the local nodes it constrains. Its impulse goes to entry `load` of

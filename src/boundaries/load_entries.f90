@@ -3,10 +3,11 @@
 !> it: the `&wall` groups, the `&box_walls` sides that are walls (x_min, x_max, y_min, ... in that order),
 !> the `&inlet` groups (an inlet's feeder and its closing walls are one entry), the `&structure` groups.
 !> The walls and structures built from the scene (boundary_walls, fluid_inflow) take their entry from
-!> here, and wall_loads names its columns from here.
+!> here, and wall_loads names its columns from here. The box sides as `&wall` entries (box_side_walls) are
+!> here too: the walls built from them and their entries come from the one enumeration.
 module load_entries
-   use kinds, only: name_len
-   use scene_description, only: scene_t, wall_none
+   use kinds, only: rp, name_len
+   use scene_description, only: scene_t, wall_spec_t, grid_spec_t, wall_none
    implicit none
    private
 
@@ -19,7 +20,7 @@ module load_entries
       integer :: index = 0         !< its place in that group: the k-th &wall, box side, &inlet or &structure
    end type load_entry_t
 
-   public :: scene_load_entries, entry_of, entries_before
+   public :: scene_load_entries, entry_of, entries_before, box_side_walls
 
 contains
 
@@ -27,19 +28,14 @@ contains
    function scene_load_entries(scene) result(entries)
       type(scene_t), intent(in) :: scene
       type(load_entry_t), allocatable :: entries(:)
-      integer :: i, k, side, n
+      type(wall_spec_t), allocatable :: sides(:)
+      integer :: i
       allocate (entries(0))
       if (allocated(scene%walls)) then
          entries = [entries, (load_entry_t(scene%walls(i)%name, entry_wall, i), i = 1, size(scene%walls))]
       end if
-      n = 0
-      do k = 1, scene%grid%dim
-         do side = 1, 2
-            if (scene%grid%wall(side, k) == wall_none) cycle
-            n = n + 1
-            entries = [entries, load_entry_t(scene%grid%wall_name(side, k), entry_box_side, n)]
-         end do
-      end do
+      sides = box_side_walls(scene%grid)
+      entries = [entries, (load_entry_t(sides(i)%name, entry_box_side, i), i = 1, size(sides))]
       if (allocated(scene%inlets)) then
          entries = [entries, (load_entry_t(scene%inlets(i)%name, entry_inlet, i), i = 1, size(scene%inlets))]
       end if
@@ -70,4 +66,35 @@ contains
       before = findloc(entries%group, group, 1) - 1
       if (before < 0) before = size(entries)
    end function entries_before
+
+   !> The sides of the scene box that `&box_walls` makes walls, as `&wall` entries: each is the face of
+   !> the box lower..lower + ncells h (world frame), with the normal pointing into the box.
+   pure function box_side_walls(grid) result(walls)
+      type(grid_spec_t), intent(in) :: grid
+      type(wall_spec_t), allocatable :: walls(:)
+      type(wall_spec_t) :: wall
+      real(rp) :: upper(3)
+      integer :: k, side
+      allocate (walls(0))
+      upper = grid%origin + grid%ncells * grid%cell_size
+      do k = 1, grid%dim
+         do side = 1, 2
+            if (grid%wall(side, k) == wall_none) cycle
+            wall%condition = grid%wall(side, k)
+            wall%friction = grid%wall_friction
+            wall%name = grid%wall_name(side, k)
+            wall%normal = 0.0_rp
+            wall%normal(k) = merge(1.0_rp, -1.0_rp, side == 1)
+            wall%lower = grid%origin
+            wall%upper = upper
+            wall%point = grid%origin
+            if (side == 2) wall%point(k) = upper(k)
+            wall%lower(k) = wall%point(k)
+            wall%upper(k) = wall%point(k)
+            ! the moment of a box side is taken about its lower corner
+            wall%moment_point = wall%point
+            walls = [walls, wall]
+         end do
+      end do
+   end function box_side_walls
 end module load_entries
