@@ -2,7 +2,7 @@
 !> "Loads, gauges and bodies"). Each surface that takes load from the material is one entry, named as the scene names
 !> it: the `&wall` groups, the `&box_walls` sides that are walls (x_min, x_max, y_min, ... in that order),
 !> the `&inlet` groups (an inlet's feeder and its closing walls are one entry), the `&structure` groups.
-!> The walls and structures built from the scene (boundary_walls, fluid_inflow) take their entry from
+!> The constraints built from the scene (constraint_factory) take their entry from
 !> here, and wall_loads names its columns from here. The box sides as `&wall` entries (box_side_walls) are
 !> here too: the walls built from them and their entries come from the one enumeration.
 module load_entries

@@ -7,7 +7,7 @@ module input_text
    implicit none
    private
 
-   public :: lower_case, upper_case, int_text, real_text, ordinal, quoted_list
+   public :: lower_case, upper_case, int_text, real_text, real_list_text, ordinal, quoted_list
    public :: keyword_index, canonical_keyword, group_context
 
    !> Integer to text, for default and 8-byte integers.
@@ -20,24 +20,28 @@ contains
    pure function lower_case(text) result(folded)
       character(len=*), intent(in) :: text
       character(len=len(text)) :: folded
-      integer :: i, code
-      folded = text
-      do i = 1, len(text)
-         code = iachar(text(i:i))
-         if (code >= iachar('A') .and. code <= iachar('Z')) folded(i:i) = achar(code + 32)
-      end do
+      folded = shifted_letters(text, 'A', 'Z', 32)
    end function lower_case
 
    pure function upper_case(text) result(folded)
       character(len=*), intent(in) :: text
       character(len=len(text)) :: folded
+      folded = shifted_letters(text, 'a', 'z', -32)
+   end function upper_case
+
+   !> `text` with the ASCII letters first .. last moved by `shift` codes (the other case).
+   pure function shifted_letters(text, first, last, shift) result(folded)
+      character(len=*), intent(in) :: text
+      character(len=1), intent(in) :: first, last
+      integer, intent(in) :: shift
+      character(len=len(text)) :: folded
       integer :: i, code
       folded = text
       do i = 1, len(text)
          code = iachar(text(i:i))
-         if (code >= iachar('a') .and. code <= iachar('z')) folded(i:i) = achar(code - 32)
+         if (code >= iachar(first) .and. code <= iachar(last)) folded(i:i) = achar(code + shift)
       end do
-   end function upper_case
+   end function shifted_letters
 
    pure function int_text_default(value) result(text)
       integer, intent(in) :: value
@@ -54,6 +58,17 @@ contains
       write (buffer, '(i0)') value
       text = trim(buffer)
    end function int_text_i8
+
+   !> "1.0, -9.81, 0.0": each value as real_text writes it.
+   function real_list_text(values) result(text)
+      real(rp), intent(in) :: values(:)
+      character(len=:), allocatable :: text
+      integer :: i
+      text = real_text(values(1))
+      do i = 2, size(values)
+         text = text//', '//real_text(values(i))
+      end do
+   end function real_list_text
 
    !> Shortest decimal text that reads back as exactly `value`: 0.5, -1.0, 2200000000.0, 1.0e-10.
    function real_text(value) result(text)

@@ -65,9 +65,14 @@ module scene_validation
    !> Accepted `&box_walls` keywords (stored lower case).
    character(len=*), parameter, public :: wall_keywords(*) = [character(len=8) :: wall_none, wall_slip, wall_no_slip, &
                                                               wall_friction]
-   !> Accepted `&wall condition=` and `&structure condition=` keywords (stored lower case).
+   !> Accepted `&structure condition=` keywords (stored lower case).
    character(len=*), parameter, public :: wall_condition_keywords(*) = [character(len=8) :: wall_slip, wall_no_slip, &
                                                                         wall_friction]
+   !> `&wall condition = 'free'`: a wall that constrains nothing and reports a zero load (free_condition).
+   character(len=*), parameter, public :: wall_free = 'free'
+   !> Accepted `&wall condition=` keywords.
+   character(len=*), parameter, public :: wall_group_condition_keywords(*) = [character(len=8) :: &
+                                                                              wall_condition_keywords, wall_free]
    !> Accepted `&material model=` keywords (stored lower case).
    character(len=*), parameter, public :: model_keywords(*) = &
       [character(len=15) :: model_newtonian_fluid, model_linear_elastic, model_rigid]
@@ -1163,8 +1168,8 @@ contains
          end if
          if (.not. status%ok) return
       end do
-      if (all(wall%condition /= wall_condition_keywords)) then
-         call status%fail(where//': variable condition must be one of '//quoted_list(wall_condition_keywords)// &
+      if (all(wall%condition /= wall_group_condition_keywords)) then
+         call status%fail(where//': variable condition must be one of '//quoted_list(wall_group_condition_keywords)// &
                           ", got '"//trim(wall%condition)//"'")
       end if
       call check_friction(where, wall%condition, wall%friction, status)

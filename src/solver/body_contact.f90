@@ -25,7 +25,7 @@ module body_contact
    use scene_description, only: scene_t
    use background_grid, only: grid_t, row_mass
    use particle_set, only: particle_set_t
-   use boundary_walls, only: wall_t, apply_wall_constraints
+   use constraint_list, only: constraint_list_t
    use body_motion, only: body_motion_t
    implicit none
    private
@@ -43,7 +43,7 @@ module body_contact
       logical, allocatable :: contact_material(:)    !< (material) its bodies are body fields
       !> (field, field): the Coulomb coefficient of the pair's &contact, -1 where none: they stick
       real(rp), allocatable :: friction(:, :)
-      integer :: structures = 0                      !< the scene's &structure groups (the last walls)
+      integer :: structures = 0                      !< the scene's &structure groups
       !> (structure, field): the Coulomb coefficient of the &contact of the field's material and the
       !> structure, -1 where none: the structure's own condition
       real(rp), allocatable :: structure_friction(:, :)
@@ -162,14 +162,17 @@ contains
       end do
    end subroutine contact_init
 
-   !> (wall, field) the mu wall w applies to body field f instead of its condition, -1 where none: the
-   !> structures are the last `structures` of the n_walls walls (mpm_solver's build_boundaries).
-   pure function contact_wall_friction(self, n_walls) result(friction)
+   !> (constraint, field) the mu constraint w applies to body field f instead of its condition, -1 where
+   !> none; structure(w) is constraint w's &structure number, 0 if it is not one (constraint_list).
+   pure function contact_wall_friction(self, structure) result(friction)
       class(contact_t), intent(in) :: self
-      integer, intent(in) :: n_walls
-      real(rp) :: friction(n_walls, self%fields)
+      integer, intent(in) :: structure(:)
+      real(rp) :: friction(size(structure), self%fields)
+      integer :: w
       friction = -1.0_rp
-      if (self%structures > 0) friction(n_walls - self%structures + 1:, :) = self%structure_friction
+      do w = 1, size(structure)
+         if (structure(w) > 0) friction(w, :) = self%structure_friction(structure(w), :)
+      end do
    end function contact_wall_friction
 
    !> particle_field(p) for this step's particles: the body field whose id range holds the id (a binary
@@ -287,22 +290,22 @@ contains
    !> algorithms.md section 9.1), a structure with a &contact to a body field's material as a friction
    !> surface with that mu, then dv = v^{n+1} - v^n. field_impulse(:, w, f) gains body field f's share of
    !> impulse(:, w).
-   subroutine contact_apply_walls(self, walls, grid, impulse, field_impulse)
+   subroutine contact_apply_walls(self, constraints, grid, impulse, field_impulse)
       class(contact_t), intent(inout) :: self
-      type(wall_t), intent(in) :: walls(:)
+      type(constraint_list_t), intent(in) :: constraints
       type(grid_t), intent(in) :: grid
       real(rp), intent(inout) :: impulse(:, :)
       real(rp), intent(inout) :: field_impulse(:, :, :)
-      real(rp) :: friction(size(walls), self%fields), share(size(impulse, 1), size(walls))
+      real(rp) :: friction(constraints%count(), self%fields), share(size(impulse, 1), constraints%count())
       integer :: f, o, dim
       dim = self%dim
-      friction = self%wall_friction(size(walls))
-      call apply_wall_constraints(walls, dim, self%velocity(1:dim, :), self%common_mass, impulse)
+      friction = self%wall_friction(constraints%structure)
+      call constraints%constrain(dim, self%velocity(1:dim, :), self%common_mass, impulse)
       do f = 1, self%fields
          o = f * dim
          share = 0.0_rp
-         call apply_wall_constraints(walls, dim, self%velocity(o + 1:o + dim, :), &
-                                     grid%accumulated(self%field_row + (f - 1) * self%stride, :), share, friction(:, f))
+         call constraints%constrain(dim, self%velocity(o + 1:o + dim, :), &
+                                    grid%accumulated(self%field_row + (f - 1) * self%stride, :), share, friction(:, f))
          impulse = impulse + share
          field_impulse(:, :, f) = field_impulse(:, :, f) + share
       end do
@@ -316,14 +319,14 @@ contains
    !> taking the approach out of them (but not out of the particles' momentum) lets the stress see a
    !> compression the bodies' motion never made. A stiff or slow impact then gained kinetic energy
    !> (E = 1e8 Pa: +65 %; docs/contact.md, "Energy in stiff impacts") [R].
-   subroutine contact_remapped_velocities(self, walls, grid, tolerance)
+   subroutine contact_remapped_velocities(self, constraints, grid, tolerance)
       class(contact_t), intent(inout) :: self
-      type(wall_t), intent(in) :: walls(:)
+      type(constraint_list_t), intent(in) :: constraints
       type(grid_t), intent(in) :: grid
       real(rp), intent(in) :: tolerance
       integer :: i, f, o, row, dim
       real(rp) :: m, v(grid%dim)
-      real(rp) :: friction(size(walls), self%fields)
+      real(rp) :: friction(constraints%count(), self%fields)
 
       dim = grid%dim
       associate (acc => grid%accumulated, r => self%remapped)
@@ -346,11 +349,11 @@ contains
             r(1:dim, i) = v
          end do
       end associate
-      call apply_wall_constraints(walls, dim, self%remapped(1:dim, :))
-      friction = self%wall_friction(size(walls))
+      call constraints%constrain(dim, self%remapped(1:dim, :))
+      friction = self%wall_friction(constraints%structure)
       do f = 1, self%fields
          o = f * dim
-         call apply_wall_constraints(walls, dim, self%remapped(o + 1:o + dim, :), friction=friction(:, f))
+         call constraints%constrain(dim, self%remapped(o + 1:o + dim, :), friction=friction(:, f))
       end do
    end subroutine contact_remapped_velocities
 

@@ -30,8 +30,7 @@ module fluid_inflow
    use background_grid, only: grid_t
    use domain_decomposition, only: domain_t
    use particle_set, only: particle_set_t
-   use boundary_walls, only: wall_t, make_wall, wall_kind_slip, wall_kind_prescribed
-   use load_entries, only: load_entry_t, entry_of, entry_inlet
+   use constraint_list, only: constraint_list_t
    use newtonian_fluid, only: eos_density
    implicit none
    private
@@ -40,8 +39,6 @@ module fluid_inflow
    integer(i8), parameter :: ids_per_inlet = 2_i8**40
    !> Relative tolerance of "L >= k Dp" (a layer due at exactly t must not be missed by round-off).
    real(rp), parameter :: layer_tolerance = 1.0e-9_rp
-   !> Extent tolerance of the opening's nodes, in cells: only nodes on the opening itself are fed.
-   real(rp), parameter :: opening_margin = 1.0e-6_rp
 
    type, public :: inlet_t
       type(inlet_spec_t) :: spec
@@ -56,7 +53,7 @@ module fluid_inflow
       logical :: hydrograph = .false.          !< the speed (and height) follow `table`
       type(time_table_t) :: table              !< velocity_file: columns velocity[, height]
       real(rp) :: depth = 1.0_rp               !< W in 3-D, 1 in 2-D [m]
-      integer :: feeder = 0                    !< index of the feeder wall (prescribed velocity) in the walls
+      integer :: feeder = 0                    !< the constraint that is its feeder (prescribed velocity)
    contains
       procedure :: injected_length => inlet_injected_length
       procedure :: layers_due => inlet_layers_due
@@ -72,18 +69,15 @@ module fluid_inflow
 
 contains
 
-   !> The scene's inlets, and their walls appended to `walls` (after the scene's walls, so that the
-   !> feeder's prescribed velocity wins where they meet). first_id: the first id after the bodies'. The
-   !> walls of inlet i report to its entry of loads.csv (`entries`, load_entries).
-   subroutine build_inlets(scene, grid, first_id, entries, inlets, walls)
+   !> The scene's inlets; their feeder and closing walls are constraints (constraint_factory), inlet i's
+   !> feeder constraints%feeder(i). first_id: the first id after the bodies'.
+   subroutine build_inlets(scene, first_id, constraints, inlets)
       type(scene_t), intent(in) :: scene
-      type(grid_t), intent(in) :: grid
       integer(i8), intent(in) :: first_id
-      type(load_entry_t), intent(in) :: entries(:)
+      type(constraint_list_t), intent(in) :: constraints
       type(inlet_t), allocatable, intent(out) :: inlets(:)
-      type(wall_t), allocatable, intent(inout) :: walls(:)
-      integer :: i, dim, load
-      real(rp) :: far_end(3), lower(3), upper(3), margin, volume_across
+      integer :: i, dim
+      real(rp) :: far_end(3), volume_across
 
       dim = scene%grid%dim
       if (.not. allocated(scene%inlets)) then
@@ -119,19 +113,7 @@ contains
 
             far_end = opening_far_end(spec, dim)
             inlet%stream_top = max(dot_product(inlet%up, spec%point), dot_product(inlet%up, far_end))
-            lower = min(spec%point, far_end)
-            upper = max(spec%point, far_end)
-            margin = opening_margin * scene%grid%cell_size
-            load = entry_of(entries, entry_inlet, i)
-            inlet%feeder = size(walls) + 1
-            walls = [walls, make_wall(grid, spec%point, spec%direction, lower, upper, margin, wall_kind_prescribed, &
-                                      velocity=spec%velocity * spec%direction, active_from=spec%start_time, &
-                                      active_until=spec%end_time, load=load), &
-                     make_wall(grid, spec%point, spec%direction, lower, upper, margin, wall_kind_slip, &
-                               active_from=spec%end_time, load=load)]
-            if (spec%start_time > 0.0_rp) &
-               walls = [walls, make_wall(grid, spec%point, spec%direction, lower, upper, margin, wall_kind_slip, &
-                                         active_until=spec%start_time, load=load)]
+            inlet%feeder = constraints%feeder(i)
          end associate
       end do
    end subroutine build_inlets
@@ -234,16 +216,16 @@ contains
 
    !> Set the feeder wall's prescribed velocity to the inflow speed at time t (a hydrograph; a constant
    !> inlet's feeder keeps v0 from build_inlets).
-   subroutine inlet_feed(self, walls, grid, t)
+   subroutine inlet_feed(self, constraints, grid, t)
       class(inlet_t), intent(in) :: self
-      type(wall_t), intent(inout) :: walls(:)
+      type(constraint_list_t), intent(inout) :: constraints
       type(grid_t), intent(in) :: grid
       real(rp), intent(in) :: t
       integer :: dim
       if (.not. self%hydrograph) return
       dim = grid%dim
-      walls(self%feeder)%velocity = 0.0_rp
-      walls(self%feeder)%velocity(1:dim) = grid%frame%grid_vector(self%speed(t) * self%spec%direction(1:dim))
+      call constraints%items(self%feeder)%item%condition%prescribe( &
+         grid%frame%grid_vector(self%speed(t) * self%spec%direction(1:dim)))
    end subroutine inlet_feed
 
    !> The integral of v H dt over [t0, t1] for a table of columns (velocity, height): per piece between

@@ -17,7 +17,7 @@ module mpm_solver
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use error_status, only: status_t
    use communication_counters, only: count_collective, comm_time_step, comm_balance, comm_other, real_bytes, int8_bytes
-   use scene_description, only: scene_t, run_control_t, wall_spec_t, model_newtonian_fluid, gauge_wall_pressure
+   use scene_description, only: scene_t, run_control_t, model_newtonian_fluid, gauge_wall_pressure
    use wall_pressure_taps, only: wall_sensor_t
    use domain_decomposition, only: domain_t, layout_dims, fit_box, min_slab_width
    use shape_functions, only: shape_function_kind, ghost_node_layers, shape_linear
@@ -38,9 +38,8 @@ module mpm_solver
    use stabilizer_factory, only: build_stabilizers
    use c0_anti_locking, only: c0_anti_locking_t
    use volume_correction, only: volume_corrector_t, max_shift_in_cells
-   use boundary_walls, only: wall_t, build_walls, build_structures, set_wall_activity, apply_wall_constraints, &
-                             keep_particles_inside, first_particle_inside, wall_distance, move_walls, &
-                             place_moving_walls, moving_wall_speed, attach_wall_sensors
+   use constraint_list, only: constraint_list_t
+   use constraint_factory, only: build_constraints
    use fluid_inflow, only: inlet_t, build_inlets
    use wall_loads, only: wall_loads_t
    use fluid_gauges, only: fluid_gauges_t
@@ -55,7 +54,7 @@ module mpm_solver
                             slack_cells
    use status_broadcast, only: agree_on_status
    use health_check, only: particles_healthy, motion_scan_t, scan_motion, merge_motion_scans
-   use input_text, only: int_text, real_text, group_context
+   use input_text, only: int_text, real_text, real_list_text, group_context
    use phase_timers, only: phase_timers_t, phase_particles_to_grid, phase_grid_update, phase_walls, &
                            phase_stabilization, phase_grid_to_particles, phase_constitutive, phase_inflow, &
                            phase_halo, phase_migration, phase_sort, phase_time_step, phase_volume_correction, &
@@ -80,7 +79,7 @@ module mpm_solver
       type(material_slot_t), allocatable :: materials(:)
       type(stabilizer_slot_t), allocatable :: schemes(:)
       type(volume_corrector_t) :: volume        !< fluid volume consistency options (none by default)
-      type(wall_t), allocatable :: walls(:)
+      type(constraint_list_t) :: constraints   !< walls, box sides, inlets' walls, structures (loads.csv order)
       type(inlet_t), allocatable :: inlets(:)
       type(wall_loads_t) :: loads               !< impulse of every wall since the last row of loads.csv
       !> per wall-pressure gauge, how far its point lies from the surface of its wall [m] (checked at the start)
@@ -229,11 +228,13 @@ contains
       call agree_on_status(status, self%domain%comm)
    end subroutine solver_check_particle_memory
 
-   !> The walls (with their local nodes), the inlets (with their feeder walls) and the structures of the
-   !> scene, in the order of the entries of loads.csv.
+   !> The boundary constraints (walls, box sides, inlets' walls, structures, with their local nodes, in the
+   !> order of the entries of loads.csv), the inlets and the wall-pressure sensors.
    subroutine build_boundaries(self)
       type(solver_t), intent(inout) :: self
-      call build_walls_and_structures(self)
+      call build_constraints(self%scene, self%grid, self%time, self%constraints)
+      ! inlet ids start after every id of the bodies (their whole lattices, not just the particles kept)
+      call build_inlets(self%scene, scene_id_count(self%scene), self%constraints, self%inlets)
       call attach_sensors(self)
    end subroutine build_boundaries
 
@@ -256,7 +257,7 @@ contains
       end if
       if (allocated(self%sensor_offset)) deallocate (self%sensor_offset)
       allocate (self%sensor_offset(size(sensors)))
-      if (size(sensors) > 0) call attach_wall_sensors(self%walls, self%grid, sensors, entries, self%sensor_offset)
+      if (size(sensors) > 0) call self%constraints%attach_sensors(self%grid, sensors, entries, self%sensor_offset)
    end subroutine attach_sensors
 
    !> A wall-pressure gauge's point must lie on its wall's surface (within half a cell, on the rank that
@@ -281,50 +282,22 @@ contains
       end do
    end subroutine check_wall_sensors
 
-   subroutine build_walls_and_structures(self)
-      type(solver_t), intent(inout) :: self
-      type(wall_spec_t), allocatable :: no_walls(:)
-      ! each surface reports to its entry of loads.csv (load_entries, via self%loads)
-      associate (entries => self%loads%entries)
-         if (allocated(self%scene%walls)) then
-            if (allocated(self%scene%wall_tables)) then
-               call build_walls(self%scene%walls, self%scene%grid, self%grid, entries, self%walls, self%scene%gravity, &
-                                self%time, self%scene%wall_tables)
-            else
-               call build_walls(self%scene%walls, self%scene%grid, self%grid, entries, self%walls, self%scene%gravity, &
-                                self%time)
-            end if
-         else
-            allocate (no_walls(0))
-            call build_walls(no_walls, self%scene%grid, self%grid, entries, self%walls)
-         end if
-         ! inlet ids start after every id of the bodies (their whole lattices, not just the particles kept)
-         call build_inlets(self%scene, self%grid, scene_id_count(self%scene), entries, self%inlets, self%walls)
-         if (.not. allocated(self%scene%structures)) return
-         if (allocated(self%scene%structure_tables)) then
-            call build_structures(self%scene%structures, self%grid, entries, self%walls, self%scene%gravity, &
-                                  self%time, self%scene%structure_tables)
-         else
-            call build_structures(self%scene%structures, self%grid, entries, self%walls, self%scene%gravity, self%time)
-         end if
-      end associate
-   end subroutine build_walls_and_structures
-
    !> A structure displaces the fluid: the particles of fluid bodies seeded inside it (phi < 0) are not
    !> kept, so that a structure can stand in water at rest [R]. Solid bodies are not cut (check_structures_clear
    !> refuses them). Local: a particle's fate depends on its position only.
    subroutine displace_fluid(self)
       type(solver_t), intent(inout) :: self
-      integer :: w, first, p, kept
+      integer :: s, p, kept
       logical :: inside
       if (.not. allocated(self%scene%structures)) return
-      first = size(self%walls) - size(self%scene%structures)
       kept = 0
       do p = 1, self%particles%count
          inside = .false.
          if (self%scene%materials(self%particles%material(p))%model == model_newtonian_fluid) then
-            do w = first + 1, size(self%walls)
-               if (wall_distance(self%walls(w), self%grid, self%particles%x(:, p)) < 0.0_rp) inside = .true.
+            do s = 1, size(self%scene%structures)
+               associate (structure => self%constraints%items(self%constraints%of_structure(s))%item)
+                  if (structure%distance(self%grid, self%particles%x(:, p)) < 0.0_rp) inside = .true.
+               end associate
             end do
          end if
          if (inside) cycle
@@ -340,13 +313,13 @@ contains
    subroutine check_structures_clear(self, status)
       type(solver_t), intent(in) :: self
       type(status_t), intent(inout) :: status
-      integer :: w, s, p, first
+      integer :: s, p
       real(rp) :: depth, x(3)
       if (.not. allocated(self%scene%structures)) return
-      first = size(self%walls) - size(self%scene%structures)
       do s = 1, size(self%scene%structures)
-         w = first + s
-         p = first_particle_inside(self%walls(w), self%grid, self%particles, depth)
+         associate (structure => self%constraints%items(self%constraints%of_structure(s))%item)
+            p = structure%first_particle_inside(self%grid, self%particles, depth)
+         end associate
          if (p == 0) cycle
          x = 0.0_rp
          x(1:self%grid%dim) = self%grid%frame%world_point(self%particles%x(:, p))
@@ -354,24 +327,12 @@ contains
                                         trim(self%scene%structures(s)%name)//"'")// &
                           ": the structure overlaps a body at the start: a particle of material '"// &
                           trim(self%scene%materials(self%particles%material(p))%name)//"' at "// &
-                          point_text(x(1:self%grid%dim))//' lies '//real_text(depth)// &
+                          '('//real_list_text(x(1:self%grid%dim))//')'//' lies '//real_text(depth)// &
                           ' m inside it (move the body or the structure)')
          exit
       end do
       call agree_on_status(status, self%domain%comm)
    end subroutine check_structures_clear
-
-   !> "(0.1, 0.25)"
-   function point_text(x) result(text)
-      real(rp), intent(in) :: x(:)
-      character(len=:), allocatable :: text
-      integer :: k
-      text = '('//real_text(x(1))
-      do k = 2, size(x)
-         text = text//', '//real_text(x(k))
-      end do
-      text = text//')'
-   end function point_text
 
    !> Solver arrays over the local nodes (the grid's own arrays are sized by grid%init).
    subroutine size_node_arrays(self)
@@ -500,17 +461,17 @@ contains
 
       dt = self%dt
       call self%timers%switch_to(phase_walls)
-      call set_wall_activity(self%walls, self%time)
+      call self%constraints%set_activity(self%time)
       ! a hydrograph's feeder carries the speed of the fluid injected at the end of this step
       do i = 1, size(self%inlets)
-         call self%inlets(i)%feed(self%walls, self%grid, self%time + dt)
+         call self%inlets(i)%feed(self%constraints, self%grid, self%time + dt)
       end do
       ! moving walls and structures: placed at t_n (node lists rebuilt), their velocity the mean over the step
-      call move_walls(self%walls, self%grid, self%time, self%time + dt)
-      call self%loads%begin_step(size(self%walls))
+      call self%constraints%move(self%grid, self%time, self%time + dt)
+      call self%loads%begin_step(self%constraints%count())
       if (self%volume%shifting) then
          call self%timers%switch_to(phase_volume_correction)
-         call self%volume%prepare(self%domain, self%grid, self%walls, self%particles, self%step)
+         call self%volume%prepare(self%domain, self%grid, self%constraints, self%particles, self%step)
       end if
       context%domain => self%domain
       context%grid => self%grid
@@ -543,7 +504,7 @@ contains
       if (self%volume%shifting_now) then
          ! the occupancy and the shifts at x^n, with the transfer's stencils
          call self%timers%switch_to(phase_volume_correction)
-         call self%volume%measure_excess(self%domain, self%grid, self%walls, self%particles, self%stencils)
+         call self%volume%measure_excess(self%domain, self%grid, self%constraints, self%particles, self%stencils)
       end if
       call self%timers%switch_to(phase_grid_update)
       call update_nodes(self, dt)
@@ -599,18 +560,20 @@ contains
 
       call self%timers%switch_to(phase_walls)
       ! the safeguard against the moving walls and structures where they are at the step's end
-      call place_moving_walls(self%walls, self%grid, self%time + dt)
+      call self%constraints%place(self%grid, self%time + dt)
       if (self%contact%active) then
-         call keep_particles_inside(self%walls, self%grid, self%particles, self%extent(:, 1), self%extent(:, 2), &
-                                    self%wall_corrections, self%loads%step_impulse, self%contact%particle_field, &
-                                    self%contact%wall_friction(size(self%walls)), self%loads%field_impulse, &
-                                    skip=self%rigid%rigid_material)
+         call self%constraints%keep_particles_inside(self%grid, self%particles, self%extent(:, 1), &
+                                                     self%extent(:, 2), self%wall_corrections, &
+                                                     self%loads%step_impulse, self%contact%particle_field, &
+                                                     self%contact%wall_friction(self%constraints%structure), &
+                                                     self%loads%field_impulse, skip=self%rigid%rigid_material)
       else
-         call keep_particles_inside(self%walls, self%grid, self%particles, self%extent(:, 1), self%extent(:, 2), &
-                                    self%wall_corrections, self%loads%step_impulse, skip=self%rigid%rigid_material)
+         call self%constraints%keep_particles_inside(self%grid, self%particles, self%extent(:, 1), &
+                                                     self%extent(:, 2), self%wall_corrections, &
+                                                     self%loads%step_impulse, skip=self%rigid%rigid_material)
       end if
       call self%timers%switch_to(phase_loads)
-      call self%loads%end_step(self%walls)
+      call self%loads%end_step(self%constraints%loads)
       call self%timers%switch_to(phase_inflow)
       created = 0
       do i = 1, size(self%inlets)
@@ -716,7 +679,7 @@ contains
       if (self%contact%active) then
          call self%contact%nodal_velocities(self%grid, dt, self%mass_tolerance)
          call self%timers%switch_to(phase_walls)
-         call self%contact%apply_walls(self%walls, self%grid, self%loads%step_impulse, self%loads%field_impulse)
+         call self%contact%apply_walls(self%constraints, self%grid, self%loads%step_impulse, self%loads%field_impulse)
          call self%timers%switch_to(phase_grid_update)
          if (self%rigid%active) call solve_rigid_bodies(self, dt)
          return
@@ -736,15 +699,15 @@ contains
             call solve_rigid_bodies(self, dt)
             before_walls = v
             call self%timers%switch_to(phase_walls)
-            call apply_wall_constraints(self%walls, dim, v, acc(row_mass, :), self%loads%step_impulse, &
-                                        skip=self%rigid%held)
+            call self%constraints%constrain(dim, v, acc(row_mass, :), self%loads%step_impulse, &
+                                            skip=self%rigid%held)
             call self%timers%switch_to(phase_grid_update)
             dv = dv + (v - before_walls)
          else
             call self%timers%switch_to(phase_walls)
             ! the walls' impulse on the nodes is the load on them (algorithms.md section 9.1); the MUSL re-map
             ! below applies the walls again to velocities only, which moves no momentum
-            call apply_wall_constraints(self%walls, dim, v, acc(row_mass, :), self%loads%step_impulse)
+            call self%constraints%constrain(dim, v, acc(row_mass, :), self%loads%step_impulse)
             call self%timers%switch_to(phase_grid_update)
             dv = v - dv
          end if
@@ -812,10 +775,10 @@ contains
       type(solver_t), intent(inout) :: self
       real(rp), intent(in) :: dt
       if (self%contact%active) then
-         call self%rigid%solve(self%domain, self%grid, self%particles, self%walls, dt, self%domain%rank == 0, &
+         call self%rigid%solve(self%domain, self%grid, self%particles, self%constraints, dt, self%domain%rank == 0, &
                                self%loads%step_impulse, self%contact, self%loads%field_impulse)
       else
-         call self%rigid%solve(self%domain, self%grid, self%particles, self%walls, dt, self%domain%rank == 0, &
+         call self%rigid%solve(self%domain, self%grid, self%particles, self%constraints, dt, self%domain%rank == 0, &
                                self%loads%step_impulse)
       end if
    end subroutine solve_rigid_bodies
@@ -832,7 +795,7 @@ contains
          call self%timers%switch_to(phase_halo)
          call sum_shared_nodes(self%domain, self%grid, self%contact%remapped)
          call self%timers%switch_to(phase_grid_to_particles)
-         call self%contact%remapped_velocities(self%walls, self%grid, self%mass_tolerance)
+         call self%contact%remapped_velocities(self%constraints, self%grid, self%mass_tolerance)
          call self%timers%switch_to(phase_grid_to_particles)
          return
       end if
@@ -844,7 +807,7 @@ contains
       call self%timers%switch_to(phase_grid_to_particles)
       call momenta_to_velocities(self%grid%accumulated, self%mass_tolerance, self%remapped_momentum)
       call self%timers%switch_to(phase_walls)
-      call apply_wall_constraints(self%walls, self%grid%dim, self%remapped_momentum)
+      call self%constraints%constrain(self%grid%dim, self%remapped_momentum)
       call self%timers%switch_to(phase_grid_to_particles)
    end subroutine remap_velocities
 
@@ -1151,7 +1114,7 @@ contains
    !> next one is not known yet), for the time step and the active region's guard. 0 without moving walls.
    real(rp) function wall_speed_ahead(self) result(speed)
       type(solver_t), intent(in) :: self
-      speed = moving_wall_speed(self%walls, self%time, self%time + 2.0_rp * self%dt)
+      speed = self%constraints%moving_speed(self%time, self%time + 2.0_rp * self%dt)
    end function wall_speed_ahead
 
    !> CFL rho0 h^2 / (2 dim mu) over the viscous fluids present.

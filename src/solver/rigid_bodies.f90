@@ -27,7 +27,7 @@
 !> (slip 0, no_slip unbounded, friction the wall's mu). Its impulses act on the cluster S and follow from
 !> projected Gauss-Seidel over the points with accumulated impulses ("sequential impulses"); the contact is
 !> inelastic. They are part of the wall's load in loads.csv, with what its nodal constraint took. The
-!> particle safeguard of boundary_walls leaves rigid particles alone. Every rank holds every body's state
+!> particle safeguard of the constraints leaves rigid particles alone. Every rank holds every body's state
 !> and solves the same contact problem (the points gathered from all ranks and sorted by particle id), so
 !> the state is the same on every rank.
 module rigid_bodies
@@ -39,7 +39,7 @@ module rigid_bodies
    use particle_set, only: particle_set_t
    use background_grid, only: grid_t, row_mass
    use body_motion, only: body_motion_t
-   use boundary_walls, only: wall_t, behind_wall, wall_distance, surface_normal, wall_kind_no_slip, wall_kind_friction
+   use constraint_list, only: constraint_list_t
    use grid_transfer, only: spread_to_grid, mass_to_grid
    use domain_decomposition, only: domain_t
    use node_halo, only: sum_shared_nodes
@@ -229,12 +229,12 @@ contains
    !> increment, elsewhere all fields move together (the total mass, every field's rows); a structure of
    !> its &contact acts on it with the pair's mu, and field_impulse(:, w, f) gains its share of the load.
    !> Collective.
-   subroutine rigid_solve(self, domain, grid, particles, walls, dt, records_loads, impulse, contact, field_impulse)
+   subroutine rigid_solve(self, domain, grid, particles, constraints, dt, records_loads, impulse, contact, field_impulse)
       class(rigid_set_t), intent(inout) :: self
       type(domain_t), intent(in) :: domain
       type(grid_t), intent(inout) :: grid
       type(particle_set_t), intent(in) :: particles
-      type(wall_t), intent(in) :: walls(:)
+      type(constraint_list_t), intent(in) :: constraints
       real(rp), intent(in) :: dt
       logical, intent(in) :: records_loads
       real(rp), intent(inout) :: impulse(:, :)
@@ -262,7 +262,7 @@ contains
                if (contact%first_id(f) == self%bodies(b)%first_id) field(b) = f
             end do
          end do
-         field_friction = contact%wall_friction(size(walls))
+         field_friction = contact%wall_friction(constraints%structure)
       end if
       ! the bodies' masses on the nodes, and the contact points of their particles
       allocate (share(size(self%bodies), grid%node_count), records(record_width, 64))
@@ -379,35 +379,30 @@ contains
       subroutine find_contacts(p, b, r)
          integer, intent(in) :: p, b
          real(rp), intent(in) :: r(3)
-         real(rp) :: radius, x(d), normal(3), mu
+         real(rp) :: radius, x(d), normal(3), mu, phi
          integer :: w
          real(rp), allocatable :: grown(:, :)
          radius = 0.5_rp * (particles%mass(p) / particles%density(p))**(1.0_rp / d)
          x = particles%x(:, p)
-         do w = 1, size(walls)
-            if (.not. walls(w)%active) cycle
-            if (.not. behind_wall(walls(w), grid, x, radius + grid%h)) cycle
-            normal = 0.0_rp
-            normal(1:d) = surface_normal(walls(w), grid, x)
-            select case (walls(w)%kind)
-            case (wall_kind_no_slip)
-               mu = -1.0_rp
-            case (wall_kind_friction)
-               mu = walls(w)%friction
-            case default
-               mu = 0.0_rp
-            end select
-            if (fields .and. field(b) > 0) then
-               if (field_friction(w, field(b)) >= 0.0_rp) mu = field_friction(w, field(b))
-            end if
-            if (found == size(records, 2)) then
-               allocate (grown(record_width, 2 * found))
-               grown(:, 1:found) = records(:, 1:found)
-               call move_alloc(grown, records)
-            end if
-            found = found + 1
-            records(:, found) = [real(particles%id(p), rp), real(w, rp), real(b, rp), r, normal, &
-                                 wall_distance(walls(w), grid, x) - radius, mu, walls(w)%wall_velocity]
+         do w = 1, constraints%count()
+            associate (wall => constraints%items(w)%item)
+               if (.not. wall%active) cycle
+               if (.not. wall%behind(grid, x, radius + grid%h)) cycle
+               normal = 0.0_rp
+               phi = wall%distance(grid, x, normal(1:d))
+               mu = wall%traits%body_friction
+               if (fields .and. field(b) > 0) then
+                  if (field_friction(w, field(b)) >= 0.0_rp) mu = field_friction(w, field(b))
+               end if
+               if (found == size(records, 2)) then
+                  allocate (grown(record_width, 2 * found))
+                  grown(:, 1:found) = records(:, 1:found)
+                  call move_alloc(grown, records)
+               end if
+               found = found + 1
+               records(:, found) = [real(particles%id(p), rp), real(w, rp), real(b, rp), r, normal, &
+                                    phi - radius, mu, wall%wall_velocity]
+            end associate
          end do
       end subroutine find_contacts
 
@@ -421,7 +416,7 @@ contains
             w = nint(all_records(2, c))
             b = nint(all_records(3, c))
             arm = self%bodies(b)%centre + all_records(4:6, c)
-            arm(1:d) = arm(1:d) - walls(w)%moment_point(1:d)
+            arm(1:d) = arm(1:d) - constraints%items(w)%item%moment_point(1:d)
             impulse(1:d, w) = impulse(1:d, w) + j(1:d)
             impulse(4:6, w) = impulse(4:6, w) + cross(arm, j)
             if (present(field_impulse) .and. field(b) > 0) then

@@ -2,7 +2,7 @@
 !> docs/loads.md, docs/theory.md section 3.2, algorithms.md section 9.1).
 !>
 !> Every step the walls record, per wall and rank, the momentum their constraints gave the material
-!> (boundary_walls: nodal constraint m_i (v^c - v^*), counted once per shared node, and the particle
+!> (constraint: nodal constraint m_i (v^c - v^*), counted once per shared node, and the particle
 !> safeguard m_p (v^c - v)). At the end of the step these are added, per entry of loads.csv (an inlet's
 !> feeder and closing walls are one entry), to this rank's impulse since the last row: no communication
 !> per step. A row sums the ranks' impulses (one reduction) and divides by the interval's length,
@@ -19,7 +19,7 @@ module wall_loads
    use communication_counters, only: count_collective, comm_records, real_bytes
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_SUM
    use scene_description, only: scene_t, gauge_wall_pressure
-   use boundary_walls, only: wall_t, impulse_rows
+   use constraint, only: impulse_rows
    use load_entries, only: load_entry_t, scene_load_entries, entries_before, entry_structure
    use body_contact, only: contact_body_names
    use world_frame, only: frame_t
@@ -108,21 +108,23 @@ contains
    end subroutine loads_begin_step
 
    !> Add this step's impulses to this rank's impulse since the last row (per loads.csv entry).
-   subroutine loads_end_step(self, walls)
+   !> `loads` (per constraint): the entry its impulse goes to (0: none; constraint_list's loads).
+   subroutine loads_end_step(self, loads)
       class(wall_loads_t), intent(inout) :: self
-      type(wall_t), intent(in) :: walls(:)
+      integer, intent(in) :: loads(:)
       integer :: w, s, f, e
-      do w = 1, size(walls)
-         if (walls(w)%load > 0) self%impulse(:, walls(w)%load) = self%impulse(:, walls(w)%load) + self%step_impulse(:, w)
+      do w = 1, size(loads)
+         if (loads(w) > 0) self%impulse(:, loads(w)) = self%impulse(:, loads(w)) + self%step_impulse(:, w)
       end do
       do s = 1, self%sensors
          e = size(self%names) + s
-         self%impulse(:, e) = self%impulse(:, e) + self%step_impulse(:, size(walls) + s)
+         self%impulse(:, e) = self%impulse(:, e) + self%step_impulse(:, size(loads) + s)
       end do
       if (self%fields == 0) return
-      do w = 1, size(walls)
-         s = walls(w)%load - self%first_structure
-         if (.not. walls(w)%shaped .or. s < 1 .or. s > self%structures) cycle
+      ! a structure's entry: its fields' entries follow the structures' (load_entries)
+      do w = 1, size(loads)
+         s = loads(w) - self%first_structure
+         if (s < 1 .or. s > self%structures) cycle
          do f = 1, self%fields
             e = self%first_structure + self%structures + (s - 1) * self%fields + f
             self%impulse(:, e) = self%impulse(:, e) + self%field_impulse(:, w, f)

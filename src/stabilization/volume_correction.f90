@@ -44,7 +44,7 @@ module volume_correction
    use stencil_cache, only: stencil_cache_t
    use node_halo, only: sum_shared_nodes
    use particle_set, only: particle_set_t
-   use boundary_walls, only: wall_t, wall_kind_prescribed, behind_wall
+   use constraint_list, only: constraint_list_t
    use cell_binning, only: cell_list_t, start_cell_list, bin_cell_mass_and_mean
    use newtonian_fluid, only: eos_pressure
    implicit none
@@ -159,20 +159,20 @@ contains
    !> At x^n, before the step's particle-to-grid transfer, on the steps that shift (every interval-th step; by
    !> the step number, so a restart keeps the rhythm): the open volumes where the walls changed and the cells'
    !> volumes equalised.
-   subroutine corrector_prepare(self, domain, grid, walls, particles, step)
+   subroutine corrector_prepare(self, domain, grid, constraints, particles, step)
       class(volume_corrector_t), intent(inout) :: self
       type(domain_t), intent(in) :: domain
       type(grid_t), intent(in) :: grid
-      type(wall_t), intent(in) :: walls(:)
+      type(constraint_list_t), intent(in) :: constraints
       type(particle_set_t), intent(inout) :: particles
       integer(i8), intent(in) :: step
 
       self%shifting_now = self%shifting .and. mod(step, int(self%interval, i8)) == 0
       if (.not. self%shifting_now) return
       if (.not. allocated(self%wall_activity)) then
-         call measure_open_volumes(self, grid, walls)
-      else if (any(self%wall_activity .neqv. walls%active)) then
-         call measure_open_volumes(self, grid, walls)
+         call measure_open_volumes(self, grid, constraints)
+      else if (any(self%wall_activity .neqv. constraints%active)) then
+         call measure_open_volumes(self, grid, constraints)
       end if
       call equalize_cell_volumes(self, grid, particles)
    end subroutine corrector_prepare
@@ -182,11 +182,11 @@ contains
    !> surface (whose skip of blocks below the surface reads the extremes the occupancy's transfer took), psi_i
    !> and the particles' shifts. Collective. `stencils` (3-D): the transfer's (src/transfer/stencil_cache.f90),
    !> which the occupancy and the gradients read with the shortcuts instead of locating the particles again.
-   subroutine corrector_measure_excess(self, domain, grid, walls, particles, stencils)
+   subroutine corrector_measure_excess(self, domain, grid, constraints, particles, stencils)
       class(volume_corrector_t), intent(inout) :: self
       type(domain_t), intent(in) :: domain
       type(grid_t), intent(in) :: grid
-      type(wall_t), intent(in) :: walls(:)
+      type(constraint_list_t), intent(in) :: constraints
       type(particle_set_t), intent(in) :: particles
       type(stencil_cache_t), intent(in), optional, target :: stencils
       type(stencil_cache_t), pointer :: kept     ! the stencils read; disassociated (absent) the general way
@@ -212,7 +212,7 @@ contains
       self%fluid_volume = self%open_volume
       if (self%surface_model) then
          call measure_surface_heights(self, domain, grid, particles)
-         call cut_by_surface(self, grid, walls)
+         call cut_by_surface(self, grid, constraints)
       end if
       threshold = min_open_fraction * grid%h**grid%dim
       do i = 1, grid%node_count
@@ -594,10 +594,10 @@ contains
    !> coordinates, bit for bit, so the heights and surfaces are those of a lookup per sub-cell. A support there
    !> that no wall cuts takes the columns' sum in closed form (open_column_volume): the same integral as the
    !> sub-cells' sum, which it equals to round-off.
-   subroutine cut_by_surface(self, grid, walls)
+   subroutine cut_by_surface(self, grid, constraints)
       type(volume_corrector_t), intent(inout) :: self
       type(grid_t), intent(in) :: grid
-      type(wall_t), intent(in) :: walls(:)
+      type(constraint_list_t), intent(in) :: constraints
       integer, parameter :: max_columns = (2 * maxval(surface_samples_per_cell))**2   ! per_axis**(dim - 1) at most
       integer :: dim, i, j, l, k, g(3), node, s(3), per_axis, first(2), last(2), nb(2), column
       real(rp) :: x_node(3), x(3), weight, sub, reach(2), rise, lowest, volume, extent(3), u, surface, share, &
@@ -612,7 +612,7 @@ contains
       integer :: horizontal_node(2), second(2)
 
       dim = grid%dim
-      counts = walls%active .and. walls%kind /= wall_kind_prescribed
+      counts = constraints%active .and. constraints%blocks_flow
       per_axis = 2 * surface_samples_per_cell(dim)
       sub = grid%h / surface_samples_per_cell(dim)
       sub_volume = sub**dim
@@ -666,7 +666,7 @@ contains
                   cycle
                end if
                call support_samples(grid, x_node, surface_samples_per_cell(dim), sample_x, axis_weight)
-               if (.not. self%fully_open(node)) near = walls_near(self, grid, walls, counts, x_node)
+               if (.not. self%fully_open(node)) near = walls_near(self, grid, constraints, counts, x_node)
                volume = 0.0_rp
                if (upright) then
                   call column_heights(column_height)
@@ -711,7 +711,7 @@ contains
          end if
          weight = weight * share
          if (weight > 0.0_rp) then
-            if (.not. self%fully_open(node)) weight = weight * open_fraction(grid, walls, near, x)
+            if (.not. self%fully_open(node)) weight = weight * open_fraction(grid, constraints, near, x)
             volume = volume + weight
          end if
       end subroutine add_sample
@@ -900,18 +900,18 @@ contains
    !> V_i = int N_i over the part of the grid box in front of every active slip or no-slip wall, by
    !> midpoint quadrature (samples_per_cell^dim points in each of the 2^dim cells around the node).
    !> A feeder (prescribed) wall lets fluid through and does not count.
-   subroutine measure_open_volumes(self, grid, walls)
+   subroutine measure_open_volumes(self, grid, constraints)
       type(volume_corrector_t), intent(inout) :: self
       type(grid_t), intent(in) :: grid
-      type(wall_t), intent(in) :: walls(:)
+      type(constraint_list_t), intent(in) :: constraints
       integer :: dim, i, j, l, g(3), node, s(3), per_axis, k
       real(rp) :: x_node(3), x(3), weight, unit_weight, top(3), reach, sample_x(2 * maxval(samples_per_cell), 3), &
                   axis_weight(2 * maxval(samples_per_cell), 3)
       logical, allocatable :: counts(:), near(:)
 
       dim = grid%dim
-      self%wall_activity = walls%active
-      counts = walls%active .and. walls%kind /= wall_kind_prescribed
+      self%wall_activity = constraints%active
+      counts = constraints%active .and. constraints%blocks_flow
       if (allocated(self%open_volume)) deallocate (self%open_volume, self%fully_open)
       allocate (self%open_volume(grid%node_count), self%fully_open(grid%node_count))
       per_axis = 2 * samples_per_cell(dim)
@@ -932,7 +932,7 @@ contains
                   cycle
                end if
                self%open_volume(node) = 0.0_rp
-               near = walls_near(self, grid, walls, counts, x_node)
+               near = walls_near(self, grid, constraints, counts, x_node)
                call support_samples(grid, x_node, samples_per_cell(dim), sample_x, axis_weight)
                s = 1
                do
@@ -942,7 +942,7 @@ contains
                      x(k) = sample_x(s(k), k)
                      weight = weight * axis_weight(s(k), k)
                   end do
-                  self%open_volume(node) = self%open_volume(node) + weight * open_fraction(grid, walls, near, x)
+                  self%open_volume(node) = self%open_volume(node) + weight * open_fraction(grid, constraints, near, x)
                   if (.not. next_sample(s, dim, per_axis)) exit
                end do
             end do
@@ -955,11 +955,11 @@ contains
          integer :: ww
          open = all(x_node(1:dim) - grid%h >= grid%origin(1:dim)) .and. all(x_node(1:dim) + grid%h <= top(1:dim))
          if (.not. open) return
-         do ww = 1, size(walls)
+         do ww = 1, constraints%count()
             if (.not. counts(ww)) cycle
             ! every point of the support is within reach of the node: in front by more than that, no cut
-            if (dot_product(walls(ww)%normal(1:dim), x_node(1:dim) - walls(ww)%point(1:dim)) > reach) cycle
-            if (behind_wall(walls(ww), grid, x_node(1:dim), reach, widen=reach)) then
+            if (constraints%items(ww)%item%clearly_in_front(grid, x_node(1:dim), reach)) cycle
+            if (constraints%items(ww)%item%behind(grid, x_node(1:dim), reach, widen=reach)) then
                open = .false.
                return
             end if
@@ -991,33 +991,33 @@ contains
    !> a margin of 1e-6 h, far above the rounding of a distance, keeps the decision off the edge. A
    !> structure's surface always counts. Most nodes near the walls are near one of them: the box's other
    !> walls no longer cost a test per sample. Without the shortcuts: every counted wall.
-   function walls_near(self, grid, walls, counts, x_node) result(near)
+   function walls_near(self, grid, constraints, counts, x_node) result(near)
       type(volume_corrector_t), intent(in) :: self
       type(grid_t), intent(in) :: grid
-      type(wall_t), intent(in) :: walls(:)
+      type(constraint_list_t), intent(in) :: constraints
       logical, intent(in) :: counts(:)
       real(rp), intent(in) :: x_node(3)
-      logical :: near(size(walls))
-      real(rp) :: reach, margin, distance
+      logical :: near(constraints%count())
+      real(rp) :: reach, margin
       integer :: ww, dim
       dim = grid%dim
       reach = sqrt(real(dim, rp)) * grid%h
       margin = 1.0e-6_rp * grid%h
       near = counts
       if (.not. self%shortcuts) return
-      do ww = 1, size(walls)
-         if (.not. near(ww) .or. walls(ww)%shaped) cycle
-         distance = dot_product(walls(ww)%normal(1:dim), x_node(1:dim) - walls(ww)%point(1:dim))
-         near(ww) = distance <= reach + on_wall_tolerance * grid%h + margin .and. &
-                    distance >= -(walls(ww)%depth + 2.0_rp * reach) - margin
+      do ww = 1, constraints%count()
+         if (.not. near(ww)) cycle
+         near(ww) = constraints%items(ww)%item%may_cut_support(x_node(1:dim), &
+                                                               reach + on_wall_tolerance * grid%h + margin, &
+                                                               2.0_rp * reach, margin)
       end do
    end function walls_near
 
    !> 1 if the sample x is open, 0 if it is behind a counted wall or outside the grid box, 1/2 if it
    !> lies on a wall (a wall through the node at 45 degrees passes through samples: half is exact).
-   real(rp) function open_fraction(grid, walls, counts, x) result(fraction)
+   real(rp) function open_fraction(grid, constraints, counts, x) result(fraction)
       type(grid_t), intent(in) :: grid
-      type(wall_t), intent(in) :: walls(:)
+      type(constraint_list_t), intent(in) :: constraints
       logical, intent(in) :: counts(:)
       real(rp), intent(in) :: x(3)
       real(rp) :: on_wall, reach, top(3)
@@ -1029,11 +1029,11 @@ contains
       fraction = 1.0_rp
       on_wall = on_wall_tolerance * grid%h
       reach = sqrt(real(dim, rp)) * grid%h
-      do ww = 1, size(walls)
+      do ww = 1, constraints%count()
          if (.not. counts(ww)) cycle
          ! widened: a sample of a node behind the wall may lie farther back than the wall's depth
-         if (.not. behind_wall(walls(ww), grid, x(1:dim), on_wall, widen=reach)) cycle
-         if (behind_wall(walls(ww), grid, x(1:dim), -on_wall, widen=reach)) then
+         if (.not. constraints%items(ww)%item%behind(grid, x(1:dim), on_wall, widen=reach)) cycle
+         if (constraints%items(ww)%item%behind(grid, x(1:dim), -on_wall, widen=reach)) then
             fraction = 0.0_rp
             return
          end if

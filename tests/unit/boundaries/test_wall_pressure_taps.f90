@@ -8,7 +8,9 @@ module test_wall_pressure_taps
    use kinds, only: rp
    use assertions, only: assertEqual, assertTrue
    use wall_pressure_taps, only: wall_sensor_t, pressure_taps_t, patch_weight
-   use boundary_walls, only: wall_t, apply_wall_constraints, wall_kind_slip
+   use wall_conditions, only: slip_condition_t
+   use planar_wall, only: planar_wall_t
+   use constraint_list, only: constraint_list_t
    implicit none
    private
 
@@ -135,21 +137,24 @@ contains
    !> A wall x = 0 with a sensor tap on its one node: the constraint's impulse m (v^c - v*) goes to the
    !> wall's column, and dp . vector to the sensor's column after the walls'.
    subroutine test_constraint_fills_the_column()
-      type(wall_t) :: walls(1)
+      type(constraint_list_t) :: walls
+      type(planar_wall_t) :: wall
       real(rp) :: v(2, 1), impulse(6, 2), feet(2, 1), normals(2, 1)
-      walls(1)%normal(1:2) = [1.0_rp, 0.0_rp]
-      walls(1)%kind = wall_kind_slip
-      walls(1)%nodes = [1]
-      walls(1)%counted = [.true.]
-      allocate (walls(1)%arm(3, 1))
-      walls(1)%arm = 0.0_rp
-      walls(1)%taps%sensors = [sensor_2d(5.0_rp * h, 0.5_rp * h)]
+      wall%normal(1:2) = [1.0_rp, 0.0_rp]
+      wall%normals = reshape([1.0_rp, 0.0_rp], [2, 1])
+      call wall%set_condition(slip_condition_t())
+      wall%nodes = [1]
+      wall%counted = [.true.]
+      allocate (wall%arm(3, 1))
+      wall%arm = 0.0_rp
+      wall%taps%sensors = [sensor_2d(5.0_rp * h, 0.5_rp * h)]
       feet(:, 1) = [0.0_rp, 5.0_rp * h]
       normals(:, 1) = [1.0_rp, 0.0_rp]
-      call walls(1)%taps%place(2, h, feet, normals)
+      call wall%taps%place(2, h, feet, normals)
+      call walls%append(wall, 0)
       v(:, 1) = [-2.0_rp, 1.0_rp]
       impulse = 0.0_rp
-      call apply_wall_constraints(walls, 2, v, [3.0_rp], impulse)
+      call walls%constrain(2, v, [3.0_rp], impulse)
       call assertEqual([6.0_rp, 0.0_rp], impulse(1:2, 1), 1.0e-14_rp, 'the wall: m (v^c - v*) = 3 x 2')
       call assertEqual(6.0_rp * 0.75_rp / h, impulse(1, 2), 1.0e-9_rp, 'the sensor: dp . n x 3/4 / h')
    end subroutine test_constraint_fills_the_column

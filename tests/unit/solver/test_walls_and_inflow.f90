@@ -53,9 +53,9 @@ contains
       call assertTrue(status%ok, 'box walls: '//trim(status%message))
       call b%init(walls, comm, status)
       call assertTrue(status%ok, 'wall groups: '//trim(status%message))
-      call assertEqual(size(a%walls), size(b%walls), 'number of walls')
-      do w = 1, min(size(a%walls), size(b%walls))
-         call assertEqual(size(a%walls(w)%nodes), size(b%walls(w)%nodes), 'nodes of wall')
+      call assertEqual(a%constraints%count(), b%constraints%count(), 'number of walls')
+      do w = 1, min(a%constraints%count(), b%constraints%count())
+         call assertEqual(size(a%constraints%items(w)%item%nodes), size(b%constraints%items(w)%item%nodes), 'nodes of wall')
       end do
       do step = 1, 150
          call a%advance()

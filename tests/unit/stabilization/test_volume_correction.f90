@@ -182,9 +182,9 @@ contains
          associate (s => solver(i))
             call s%volume%reset_grid()       ! the open volumes measured again, each way
             ! an application as the step makes it: prepare, the transfer (its stencils kept in 3-D), the rest
-            call s%volume%prepare(s%domain, s%grid, s%walls, s%particles, int(s%volume%interval, i8))
+            call s%volume%prepare(s%domain, s%grid, s%constraints, s%particles, int(s%volume%interval, i8))
             call particles_to_grid(s%grid, s%particles, s%gravity, stencils=s%stencils)
-            call s%volume%measure_excess(s%domain, s%grid, s%walls, s%particles, s%stencils)
+            call s%volume%measure_excess(s%domain, s%grid, s%constraints, s%particles, s%stencils)
          end associate
       end do
       call assertTrue(solver(1)%volume%shifting_now .and. solver(1)%volume%surface_model, label//': an application')
@@ -365,9 +365,9 @@ contains
          call solver(i)%particles%permute(dest)
          associate (s => solver(i))
             ! an application as the step makes it (the heights come after the transfer)
-            call s%volume%prepare(s%domain, s%grid, s%walls, s%particles, int(s%volume%interval, i8))
+            call s%volume%prepare(s%domain, s%grid, s%constraints, s%particles, int(s%volume%interval, i8))
             call particles_to_grid(s%grid, s%particles, s%gravity, stencils=s%stencils)
-            call s%volume%measure_excess(s%domain, s%grid, s%walls, s%particles, s%stencils)
+            call s%volume%measure_excess(s%domain, s%grid, s%constraints, s%particles, s%stencils)
          end associate
       end do
       associate (height => solver(1)%volume%surface_height)
