@@ -287,17 +287,16 @@ contains
    !> refuses them). Local: a particle's fate depends on its position only.
    subroutine displace_fluid(self)
       type(solver_t), intent(inout) :: self
-      integer :: s, p, kept
+      integer :: w, p, kept
       logical :: inside
       if (.not. allocated(self%scene%structures)) return
       kept = 0
       do p = 1, self%particles%count
          inside = .false.
          if (self%scene%materials(self%particles%material(p))%model == model_newtonian_fluid) then
-            do s = 1, size(self%scene%structures)
-               associate (structure => self%constraints%items(self%constraints%of_structure(s))%item)
-                  if (structure%distance(self%grid, self%particles%x(:, p)) < 0.0_rp) inside = .true.
-               end associate
+            do w = 1, self%constraints%count()
+               if (self%constraints%structure(w) == 0) cycle
+               if (self%constraints%items(w)%item%distance(self%grid, self%particles%x(:, p)) < 0.0_rp) inside = .true.
             end do
          end if
          if (inside) cycle
@@ -327,7 +326,7 @@ contains
                                         trim(self%scene%structures(s)%name)//"'")// &
                           ": the structure overlaps a body at the start: a particle of material '"// &
                           trim(self%scene%materials(self%particles%material(p))%name)//"' at "// &
-                          '('//real_list_text(x(1:self%grid%dim))//')'//' lies '//real_text(depth)// &
+                          '('//real_list_text(x(1:self%grid%dim))//') lies '//real_text(depth)// &
                           ' m inside it (move the body or the structure)')
          exit
       end do
