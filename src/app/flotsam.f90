@@ -15,7 +15,7 @@ program flotsam
    use error_status, only: status_t
    use scene_description, only: scene_t
    use scene_reader, only: read_scene, scene_override_t
-   use scene_validation, only: scene_advice
+   use scene_memory, only: scene_advice
    use output_directory, only: prepare_output_directory, prepare_restart_directory
    use mpm_solver, only: solver_t
    use run_progress, only: run_progress_t

@@ -17,8 +17,11 @@ module scene_reader
                                 model_linear_elastic, model_rigid
    use shape_geometry, only: shape_t, max_vertices, no_vertex
    use namelist_scan, only: namelist_file_t, namelist_group_t, scan_namelist_file
-   use scene_validation, only: validate_scene, resolve_scene, check_scene_memory, default_name, stabilization_keywords, &
-                               oscillation_rule_keywords
+   use scene_validation, only: validate_scene
+   use scene_defaults, only: resolve_scene, default_name
+   use scene_memory, only: check_scene_memory
+   use scene_keywords, only: stabilization_keywords, oscillation_rule_keywords
+   use input_checks, only: name_detail
    use scene_broadcast, only: broadcast_scene
    use status_broadcast, only: broadcast_status
    use input_text, only: lower_case, upper_case, int_text, ordinal, group_context, canonical_keyword
@@ -697,13 +700,6 @@ contains
          if (file%groups(i)%name == file%groups(g)%name) n = n + 1
       end do
    end function count_before
-
-   pure function name_detail(name) result(detail)
-      character(len=*), intent(in) :: name
-      character(len=:), allocatable :: detail
-      detail = ''
-      if (len_trim(name) > 0) detail = "name '"//trim(name)//"'"
-   end function name_detail
 
    pure function material_detail(material) result(detail)
       character(len=*), intent(in) :: material

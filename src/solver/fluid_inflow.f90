@@ -32,6 +32,8 @@ module fluid_inflow
    use particle_set, only: particle_set_t
    use constraint_list, only: constraint_list_t
    use newtonian_fluid, only: eos_density
+   use material_model, only: material_slot_t
+   use step_component, only: step_component_t, step_state_t
    implicit none
    private
 
@@ -65,9 +67,88 @@ module fluid_inflow
       procedure :: inject => inlet_inject
    end type inlet_t
 
+   !> The scene's inlets as a component of the step (step_component): the feeders' speeds before the walls
+   !> move, the new layers at the end of the step.
+   type, extends(step_component_t), public :: inflow_t
+      type(inlet_t), allocatable :: inlets(:)
+   contains
+      procedure :: before_walls_move => inflow_feed
+      procedure :: end_step => inflow_inject
+      procedure :: signal_speed => inflow_signal_speed
+      procedure :: lightest_particle => inflow_lightest_particle
+      procedure :: supplies => inflow_supplies
+   end type inflow_t
+
    public :: build_inlets
 
 contains
+
+   !> A hydrograph's feeder carries the speed of the fluid injected at the end of this step.
+   subroutine inflow_feed(self, state)
+      class(inflow_t), intent(inout) :: self
+      type(step_state_t), intent(inout) :: state
+      integer :: i
+      do i = 1, size(self%inlets)
+         call self%inlets(i)%feed(state%constraints, state%grid, state%time + state%dt)
+      end do
+   end subroutine inflow_feed
+
+   !> The layers due within the step, this rank's particles of them.
+   integer function inflow_inject(self, state) result(created)
+      class(inflow_t), intent(inout) :: self
+      type(step_state_t), intent(inout) :: state
+      integer :: i
+      created = 0
+      do i = 1, size(self%inlets)
+         created = created + self%inlets(i)%inject(state%time, state%time + state%dt, state%grid, state%domain, &
+                                                   state%particles)
+      end do
+   end function inflow_inject
+
+   !> An inlet that is not closed yet counts as a particle of its fluid at rho0 moving at v0 (a hydrograph:
+   !> its largest speed until it closes): the step must resolve the fluid it is about to create. With a
+   !> fixed step, the speed alone.
+   real(rp) function inflow_signal_speed(self, time, materials, dim, fixed_step) result(speed)
+      class(inflow_t), intent(in) :: self
+      real(rp), intent(in) :: time
+      type(material_slot_t), intent(in) :: materials(:)
+      integer, intent(in) :: dim
+      logical, intent(in) :: fixed_step
+      integer :: i
+      speed = 0.0_rp
+      do i = 1, size(self%inlets)
+         associate (inlet => self%inlets(i), spec => self%inlets(i)%spec)
+            if (time >= spec%end_time) cycle
+            if (fixed_step) then
+               speed = max(speed, inlet%peak_speed(time))
+            else
+               speed = max(speed, materials(spec%material_index)%model%wave_speed(inlet%density) &
+                           + sqrt(sum((inlet%peak_speed(time) * spec%direction(1:dim))**2)))
+            end if
+         end associate
+      end do
+   end function inflow_signal_speed
+
+   real(rp) function inflow_lightest_particle(self) result(mass)
+      class(inflow_t), intent(in) :: self
+      integer :: i
+      mass = huge(1.0_rp)
+      do i = 1, size(self%inlets)
+         mass = min(mass, self%inlets(i)%particle_mass)
+      end do
+   end function inflow_lightest_particle
+
+   !> An inlet of material m that has opened by `time`.
+   logical function inflow_supplies(self, m, time) result(supplies)
+      class(inflow_t), intent(in) :: self
+      integer, intent(in) :: m
+      real(rp), intent(in) :: time
+      integer :: i
+      supplies = .false.
+      do i = 1, size(self%inlets)
+         if (self%inlets(i)%spec%material_index == m .and. time >= self%inlets(i)%spec%start_time) supplies = .true.
+      end do
+   end function inflow_supplies
 
    !> The scene's inlets; their feeder and closing walls are constraints (constraint_factory), inlet i's
    !> feeder constraints%feeder(i). first_id: the first id after the bodies'.

@@ -37,10 +37,10 @@ module mpm_solver
    use stabilizer, only: stabilizer_slot_t, stage_context_t
    use stabilizer_factory, only: build_stabilizers
    use c0_anti_locking, only: c0_anti_locking_t
-   use volume_correction, only: volume_corrector_t, max_shift_in_cells
    use constraint_list, only: constraint_list_t
    use constraint_factory, only: build_constraints
-   use fluid_inflow, only: inlet_t, build_inlets
+   use step_component, only: component_slot_t, step_state_t
+   use step_component_factory, only: build_step_components
    use wall_loads, only: wall_loads_t
    use fluid_gauges, only: fluid_gauges_t
    use body_motion, only: body_motion_t
@@ -56,14 +56,18 @@ module mpm_solver
    use health_check, only: particles_healthy, motion_scan_t, scan_motion, merge_motion_scans
    use input_text, only: int_text, real_text, real_list_text, group_context
    use phase_timers, only: phase_timers_t, phase_particles_to_grid, phase_grid_update, phase_walls, &
-                           phase_stabilization, phase_grid_to_particles, phase_constitutive, phase_inflow, &
-                           phase_halo, phase_migration, phase_sort, phase_time_step, phase_volume_correction, &
+                           phase_stabilization, phase_grid_to_particles, phase_constitutive, &
+                           phase_halo, phase_migration, phase_sort, phase_time_step, &
                            phase_loads, phase_health, phase_other
    implicit none
    private
 
    !> Steps between full re-sorts of the particles when none arrived from another rank.
    integer, parameter :: sort_interval = 20
+
+   !> The stages of the step at which the components act (step_component), in the order the step reaches them.
+   integer, parameter :: stage_before_walls_move = 1, stage_walls_placed = 2, stage_grid_summed = 3, &
+                         stage_particles_moved = 4, stage_stress_updated = 5, stage_end_step = 6
 
    !> The time loop's flags that advance sets itself (solver_t%loop_flags): a particle is unhealthy
    !> (health_check), the particle arrays could not grow. The caller's own flags follow them.
@@ -78,9 +82,9 @@ module mpm_solver
       type(particle_set_t) :: particles
       type(material_slot_t), allocatable :: materials(:)
       type(stabilizer_slot_t), allocatable :: schemes(:)
-      type(volume_corrector_t) :: volume        !< fluid volume consistency options (none by default)
       type(constraint_list_t) :: constraints   !< walls, box sides, inlets' walls, structures (loads.csv order)
-      type(inlet_t), allocatable :: inlets(:)
+      !> the features of the step the scene declares (step_component): inflow, volume correction
+      type(component_slot_t), allocatable :: components(:)
       type(wall_loads_t) :: loads               !< impulse of every wall since the last row of loads.csv
       !> per wall-pressure gauge, how far its point lies from the surface of its wall [m] (checked at the start)
       real(rp), allocatable :: sensor_offset(:)
@@ -165,11 +169,13 @@ contains
       call self%grid%init(self%domain, grid_origin, scene%grid%cell_size, frame, status)
       call build_materials(scene%materials, self%materials, status)
       if (status%ok) call build_stabilizers(scene%materials, self%schemes, status)
-      call self%volume%init(scene, self%gravity)
       call agree_on_status(status, self%domain%comm)
       if (.not. status%ok) return
       call self%loads%init(scene)
       call build_boundaries(self)
+      ! inlet ids start after every id of the bodies (their whole lattices, not just the particles kept)
+      call build_step_components(self%scene, scene_id_count(self%scene), self%gravity, self%constraints, &
+                                 self%components)
       call check_wall_sensors(self, status)
       if (.not. status%ok) return
       call self%gauges%init(scene, frame, self%gravity)
@@ -205,8 +211,8 @@ contains
       ! (of the particles the bodies and the inlets make: a scene may start empty and fill through an inlet)
       min_mass = huge(1.0_rp)
       if (self%particles%count > 0) min_mass = minval(self%particles%mass(1:self%particles%count))
-      do i = 1, size(self%inlets)
-         min_mass = min(min_mass, self%inlets(i)%particle_mass)
+      do i = 1, size(self%components)
+         min_mass = min(min_mass, self%components(i)%component%lightest_particle())
       end do
       call MPI_Allreduce(MPI_IN_PLACE, min_mass, 1, MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
       call count_collective(comm_other, 1, real_bytes)
@@ -229,12 +235,10 @@ contains
    end subroutine solver_check_particle_memory
 
    !> The boundary constraints (walls, box sides, inlets' walls, structures, with their local nodes, in the
-   !> order of the entries of loads.csv), the inlets and the wall-pressure sensors.
+   !> order of the entries of loads.csv) and the wall-pressure sensors.
    subroutine build_boundaries(self)
       type(solver_t), intent(inout) :: self
       call build_constraints(self%scene, self%grid, self%time, self%constraints)
-      ! inlet ids start after every id of the bodies (their whole lattices, not just the particles kept)
-      call build_inlets(self%scene, scene_id_count(self%scene), self%constraints, self%inlets)
       call attach_sensors(self)
    end subroutine build_boundaries
 
@@ -403,7 +407,9 @@ contains
       call agree_on_status(status, self%domain%comm)
       if (.not. status%ok) return
       call build_boundaries(self)
-      call self%volume%reset_grid()
+      do k = 1, size(self%components)
+         call self%components(k)%component%layout_changed()
+      end do
       call update_cells(self%grid, self%particles)
       if (.not. same_owners) call sort_by_material_and_cell(self%grid, self%particles)
       call size_node_arrays(self)
@@ -453,25 +459,23 @@ contains
    !> One explicit step of length self%dt; afterwards self%dt holds the next stable step.
    subroutine solver_advance(self)
       class(solver_t), intent(inout), target :: self
-      integer :: m, first, last, arrived, created, i
+      integer :: m, first, last, arrived, created
       real(rp) :: dt
       type(stage_context_t) :: context
+      type(step_state_t) :: state
       logical :: smoothed(size(self%schemes))
 
       dt = self%dt
+      state = step_state_t(domain=self%domain, grid=self%grid, particles=self%particles, &
+                           constraints=self%constraints, stencils=self%stencils, time=self%time, dt=dt, &
+                           step=self%step)
       call self%timers%switch_to(phase_walls)
       call self%constraints%set_activity(self%time)
-      ! a hydrograph's feeder carries the speed of the fluid injected at the end of this step
-      do i = 1, size(self%inlets)
-         call self%inlets(i)%feed(self%constraints, self%grid, self%time + dt)
-      end do
+      call run_stage(self, stage_before_walls_move, state)
       ! moving walls and structures: placed at t_n (node lists rebuilt), their velocity the mean over the step
       call self%constraints%move(self%grid, self%time, self%time + dt)
       call self%loads%begin_step(self%constraints%count())
-      if (self%volume%shifting) then
-         call self%timers%switch_to(phase_volume_correction)
-         call self%volume%prepare(self%domain, self%grid, self%constraints, self%particles, self%step)
-      end if
+      call run_stage(self, stage_walls_placed, state)
       context%domain => self%domain
       context%grid => self%grid
       context%stencils => self%stencils
@@ -500,11 +504,7 @@ contains
       end if
       call self%timers%switch_to(phase_halo)
       call sum_shared_nodes(self%domain, self%grid, self%grid%accumulated)
-      if (self%volume%shifting_now) then
-         ! the occupancy and the shifts at x^n, with the transfer's stencils
-         call self%timers%switch_to(phase_volume_correction)
-         call self%volume%measure_excess(self%domain, self%grid, self%constraints, self%particles, self%stencils)
-      end if
+      call run_stage(self, stage_grid_summed, state)
       call self%timers%switch_to(phase_grid_update)
       call update_nodes(self, dt)
 
@@ -519,11 +519,7 @@ contains
       if (self%musl) call remap_velocities(self)
       call move_particles(self, dt)
       if (self%rigid%active) call self%rigid%finish()
-      if (self%volume%shifting_now) then
-         ! the shifts come after the extent was taken: widen it by their largest length
-         self%extent(:, 1) = self%extent(:, 1) - max_shift_in_cells * self%grid%h
-         self%extent(:, 2) = self%extent(:, 2) + max_shift_in_cells * self%grid%h
-      end if
+      call run_stage(self, stage_particles_moved, state)
 
       call self%timers%switch_to(phase_stabilization)
       do m = 1, size(self%schemes)
@@ -552,10 +548,7 @@ contains
          call set_slice(m)
          call self%schemes(m)%scheme%filter_stress(context, self%particles)
       end do
-      if (self%volume%relaxing) then
-         call self%timers%switch_to(phase_volume_correction)
-         call self%volume%relax_pressure(self%particles)
-      end if
+      call run_stage(self, stage_stress_updated, state)
 
       call self%timers%switch_to(phase_walls)
       ! the safeguard against the moving walls and structures where they are at the step's end
@@ -573,11 +566,8 @@ contains
       end if
       call self%timers%switch_to(phase_loads)
       call self%loads%end_step(self%constraints%loads)
-      call self%timers%switch_to(phase_inflow)
       created = 0
-      do i = 1, size(self%inlets)
-         created = created + self%inlets(i)%inject(self%time, self%time + dt, self%grid, self%domain, self%particles)
-      end do
+      call run_stage(self, stage_end_step, state, created)
       call self%timers%switch_to(phase_migration)
       call migrate_particles(self%domain, self%grid, self%particles, self%lost_particles, arrived)
       call self%timers%switch_to(phase_sort)
@@ -600,6 +590,36 @@ contains
       call self%timers%switch_to(phase_other)
 
    contains
+
+      !> Stage `stage` of every component, in list order, each timed as its phase; the step's phase resumes.
+      subroutine run_stage(self, stage, state, created)
+         type(solver_t), intent(inout) :: self
+         integer, intent(in) :: stage
+         type(step_state_t), intent(inout) :: state
+         integer, intent(inout), optional :: created
+         integer :: c, resume
+         resume = self%timers%current
+         do c = 1, size(self%components)
+            associate (component => self%components(c)%component)
+               call self%timers%switch_to(component%phase)
+               select case (stage)
+               case (stage_before_walls_move)
+                  call component%before_walls_move(state)
+               case (stage_walls_placed)
+                  call component%walls_placed(state)
+               case (stage_grid_summed)
+                  call component%grid_summed(state)
+               case (stage_particles_moved)
+                  call component%particles_moved(state, self%extent)
+               case (stage_stress_updated)
+                  call component%stress_updated(state)
+               case (stage_end_step)
+                  created = created + component%end_step(state)
+               end select
+            end associate
+         end do
+         if (size(self%components) > 0) call self%timers%switch_to(resume)
+      end subroutine run_stage
 
       subroutine set_slice(material)
          integer, intent(in) :: material
@@ -662,8 +682,8 @@ contains
       integer :: i
       supplied = .false.
       if (allocated(self%scene%bodies)) supplied = any(self%scene%bodies%material_index == m)
-      do i = 1, size(self%inlets)
-         if (self%inlets(i)%spec%material_index == m .and. self%time >= self%inlets(i)%spec%start_time) supplied = .true.
+      do i = 1, size(self%components)
+         if (self%components(i)%component%supplies(m, self%time)) supplied = .true.
       end do
    end function material_supplied
 
@@ -850,13 +870,13 @@ contains
          if (allocated(self%schemes(m)%scheme)) then
             call particle_kinematics(first, last, self%particles%strain_rate(:, first:last), &
                                      self%particles%spin(:, first:last))
-            if (self%volume%shifting_now) call apply_shifts(first, last)
+            call apply_shifts(first, last)
          else
             allocate (spin(merge(n_spin(dim), 0, uses_spin), block_size))
             do b = first, last, block_size
                e = min(last, b + block_size - 1)
                call particle_kinematics(b, e, rate(:, 1:e - b + 1), spin(:, 1:e - b + 1))
-               if (self%volume%shifting_now) call apply_shifts(b, e)
+               call apply_shifts(b, e)
                call self%materials(m)%model%update_stress(dim, dt, rate(:, 1:e - b + 1), spin(:, 1:e - b + 1), &
                                                          self%particles%density(b:e), self%particles%sbar(:, b:e))
             end do
@@ -867,13 +887,19 @@ contains
 
    contains
 
-      !> The volume correction's shifts of particles first:last, timed as its phase (a clock read per call:
-      !> per material with a scheme, per block without; only on the steps that shift).
+      !> The components' shifts of particles first:last (the volume correction's), each timed as its phase (a
+      !> clock read per call: per material with a scheme, per block without; only on the steps that shift).
       subroutine apply_shifts(first, last)
          integer, intent(in) :: first, last
-         call self%timers%switch_to(phase_volume_correction)
-         call self%volume%apply_shifts(self%particles, first, last)
-         call self%timers%switch_to(phase_grid_to_particles)
+         integer :: c
+         do c = 1, size(self%components)
+            associate (component => self%components(c)%component)
+               if (.not. component%shifts_now()) cycle
+               call self%timers%switch_to(component%phase)
+               call component%shift_particles(self%particles, first, last)
+               call self%timers%switch_to(phase_grid_to_particles)
+            end associate
+         end do
       end subroutine apply_shifts
 
       !> G2P of particles first:last, their rate and spin into d and w.
@@ -1025,21 +1051,16 @@ contains
             speed = max(speed, speeds(2 * m - 1) + wall_speed)
          end do
       end if
+      ! the particles a component is about to create (an open inlet's fluid)
+      do i = 1, size(self%components)
+         speed = max(speed, self%components(i)%component%signal_speed(self%time, self%materials, self%grid%dim, &
+                                                                       self%run%fixed_dt > 0.0_rp))
+      end do
       if (self%run%fixed_dt > 0.0_rp) then
          dt = self%run%fixed_dt
-         do i = 1, size(self%inlets)
-            if (self%time < self%inlets(i)%spec%end_time) speed = max(speed, self%inlets(i)%peak_speed(self%time))
-         end do
          return
       end if
       dt = huge(1.0_rp)
-      do i = 1, size(self%inlets)
-         associate (spec => self%inlets(i)%spec)
-            if (self%time >= spec%end_time) cycle
-            speed = max(speed, self%materials(spec%material_index)%model%wave_speed(self%inlets(i)%density) &
-                        + sqrt(sum((self%inlets(i)%peak_speed(self%time) * spec%direction(1:self%grid%dim))**2)))
-         end associate
-      end do
       if (speed > 0.0_rp) dt = self%run%cfl * self%grid%h / (sqrt(real(self%grid%dim, rp)) * speed)
       ! a body without waves (rigid) at rest: falling from rest it moves g dt^2 / 2 <= cfl h in the step
       if (any(self%gravity /= 0.0_rp)) dt = min(dt, sqrt(2.0_rp * self%run%cfl * self%grid%h / norm2(self%gravity)))

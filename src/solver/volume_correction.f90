@@ -32,7 +32,7 @@
 !> equalised before the step's particle-to-grid transfer (prepare); the occupancy, the surface and the shifts
 !> follow it (measure_excess), reading its stencils (3-D). The shifts are capped and added after the
 !> position update, so the wall safeguard and the migration of the step see them. Costs nothing without a
-!> fluid that selects it.
+!> fluid that selects it: it is a component of the step (step_component) only when a fluid selects it.
 module volume_correction
    use kinds, only: rp, i8
    use communication_counters, only: count_collective, comm_volume, real_bytes
@@ -47,6 +47,7 @@ module volume_correction
    use constraint_list, only: constraint_list_t
    use cell_binning, only: cell_list_t, start_cell_list, bin_cell_mass_and_mean
    use newtonian_fluid, only: eos_pressure
+   use step_component, only: step_component_t, step_state_t
    implicit none
    private
 
@@ -63,8 +64,8 @@ module volume_correction
    !> The shifting runs every k steps with k D per application, k the largest with k D <= this: the
    !> crowding builds over thousands of steps, so a k-th of the cost buys the same correction.
    real(rp), parameter :: coefficient_per_application = 0.2_rp
-   !> Largest shift per application, in cells (public: the active region widens the particles' extent by it).
-   real(rp), parameter, public :: max_shift_in_cells = 0.1_rp
+   !> Largest shift per application, in cells (the particles' extent widens by it: particles_moved).
+   real(rp), parameter :: max_shift_in_cells = 0.1_rp
    !> Horizontal bins of the height function per cell width (2-D, 3-D): finer than a particle at 3 per cell,
    !> so that a tilted surface is followed to a fraction of a particle.
    integer, parameter :: bins_per_cell(2:3) = [8, 4]
@@ -77,7 +78,7 @@ module volume_correction
    !> No particle over a bin yet.
    real(rp), parameter :: no_surface = -huge(1.0_rp)
 
-   type, public :: volume_corrector_t
+   type, extends(step_component_t), public :: volume_corrector_t
       real(rp), allocatable :: shifting_coefficient(:)  !< per material: D, 0 without shifting
       real(rp), allocatable :: relaxation_rate(:)       !< per material: r, 0 without EOS relaxation
       real(rp), allocatable :: bulk_modulus(:), reference_density(:)
@@ -117,6 +118,14 @@ module volume_correction
       procedure :: measure_excess => corrector_measure_excess
       procedure :: apply_shifts => corrector_apply_shifts
       procedure :: relax_pressure => corrector_relax_pressure
+      ! its stages of the step (step_component)
+      procedure :: walls_placed => corrector_walls_placed
+      procedure :: grid_summed => corrector_grid_summed
+      procedure :: shifts_now => corrector_shifts_now
+      procedure :: shift_particles => corrector_apply_shifts
+      procedure :: particles_moved => corrector_widen_extent
+      procedure :: stress_updated => corrector_stress_updated
+      procedure :: layout_changed => corrector_reset_grid
    end type volume_corrector_t
 
 contains
@@ -155,6 +164,41 @@ contains
       class(volume_corrector_t), intent(inout) :: self
       if (allocated(self%wall_activity)) deallocate (self%wall_activity)
    end subroutine corrector_reset_grid
+
+   !> The stages of the step: prepare with the walls at t_n, measure after P2G, shift inside G2P (the
+   !> extent widened by the longest shift), relax after the stress update.
+   subroutine corrector_walls_placed(self, state)
+      class(volume_corrector_t), intent(inout) :: self
+      type(step_state_t), intent(inout) :: state
+      if (self%shifting) call self%prepare(state%domain, state%grid, state%constraints, state%particles, state%step)
+   end subroutine corrector_walls_placed
+
+   subroutine corrector_grid_summed(self, state)
+      class(volume_corrector_t), intent(inout) :: self
+      type(step_state_t), intent(inout) :: state
+      if (self%shifting_now) call self%measure_excess(state%domain, state%grid, state%constraints, state%particles, &
+                                                      state%stencils)
+   end subroutine corrector_grid_summed
+
+   logical function corrector_shifts_now(self) result(shifts)
+      class(volume_corrector_t), intent(in) :: self
+      shifts = self%shifting_now
+   end function corrector_shifts_now
+
+   subroutine corrector_widen_extent(self, state, extent)
+      class(volume_corrector_t), intent(inout) :: self
+      type(step_state_t), intent(inout) :: state
+      real(rp), intent(inout) :: extent(3, 2)
+      if (.not. self%shifting_now) return
+      extent(:, 1) = extent(:, 1) - max_shift_in_cells * state%grid%h
+      extent(:, 2) = extent(:, 2) + max_shift_in_cells * state%grid%h
+   end subroutine corrector_widen_extent
+
+   subroutine corrector_stress_updated(self, state)
+      class(volume_corrector_t), intent(inout) :: self
+      type(step_state_t), intent(inout) :: state
+      if (self%relaxing) call self%relax_pressure(state%particles)
+   end subroutine corrector_stress_updated
 
    !> At x^n, before the step's particle-to-grid transfer, on the steps that shift (every interval-th step; by
    !> the step number, so a restart keeps the rhythm): the open volumes where the walls changed and the cells'

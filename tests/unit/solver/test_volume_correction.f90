@@ -38,6 +38,11 @@ module test_volume_correction
    use stencil_cache, only: holds_stencils
    use reproducible_numbers, only: hash01, mirror_swaps
    implicit none
+
+   !> A solver's volume correction (one of its step components).
+   type :: corrector_ref_t
+      type(volume_corrector_t), pointer :: corrector => null()
+   end type corrector_ref_t
    private
 
    public :: test_shifting_leaves_a_filled_tank_alone, test_shifting_spreads_crowded_particles, &
@@ -47,6 +52,21 @@ module test_volume_correction
              test_lowest_height_is_minval
 
 contains
+
+   !> The volume correction among the solver's step components (the scenes here all select one).
+   function corrector_of(solver) result(corrector)
+      type(solver_t), intent(in), target :: solver
+      type(volume_corrector_t), pointer :: corrector
+      integer :: c
+      corrector => null()
+      do c = 1, size(solver%components)
+         select type (component => solver%components(c)%component)
+         type is (volume_corrector_t)
+            corrector => component
+         end select
+      end do
+      call assertTrue(associated(corrector), 'the scene has a volume correction')
+   end function corrector_of
 
    !> The paper's tank (3.2 m x 6.4 m, half full, h = 0.4 m, 3 x 3 particles per cell), FOAL1, at rest;
    !> in 3-D a 1.6 m x 1.6 m x 3.2 m tank, half full, 2 x 2 x 2 particles per cell. `depth` (default: half
@@ -86,7 +106,8 @@ contains
       type(MPI_Comm), intent(in) :: comm
       integer, intent(in) :: dim
       real(rp), intent(in) :: depth
-      type(solver_t) :: plain, shifted
+      type(solver_t), target :: plain, shifted
+      type(volume_corrector_t), pointer :: volume
       type(status_t) :: status
       type(diagnostics_t) :: dp, ds
       integer :: step, n
@@ -96,17 +117,18 @@ contains
       call assertTrue(status%ok, 'plain: '//trim(status%message))
       call shifted%init(tank_scene('shifting', dim, depth), comm, status)
       call assertTrue(status%ok, 'shifting: '//trim(status%message))
+      volume => corrector_of(shifted)
       longest = 0.0_rp
       do step = 1, merge(100, 30, dim == 2)
          call plain%advance()
          call shifted%advance()
          n = shifted%particles%count
-         if (n > 0) longest = max(longest, maxval(norm2(shifted%volume%shift(:, 1:n), dim=1)))
+         if (n > 0) longest = max(longest, maxval(norm2(volume%shift(:, 1:n), dim=1)))
       end do
       call MPI_Allreduce(MPI_IN_PLACE, longest, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
       call assertTrue(longest <= 1.0e-12_rp * 0.4_rp, 'no shift in a tank filled to '//real_text(depth)//' m, got '// &
                       real_text(longest)//' m')
-      call assertTrue(longest >= 0.0_rp .and. shifted%volume%shifting, 'the shifting ran')
+      call assertTrue(longest >= 0.0_rp .and. volume%shifting, 'the shifting ran')
       dp = plain%diagnostics()
       ds = shifted%diagnostics()
       ! at rest to round-off: the kinetic energies are ~1e-30 J, compare them against the tank's rho g H^2 W / 2
@@ -147,6 +169,7 @@ contains
       type(MPI_Comm), intent(in) :: comm
       integer, intent(in) :: dim
       type(solver_t), target :: solver(2)
+      type(corrector_ref_t) :: volumes(2)
       type(scene_t) :: scene
       type(status_t) :: status
       real(rp) :: largest, difference(8), cut_counts(2), steepest, reference(dim), fullest
@@ -177,29 +200,31 @@ contains
             call solver(i)%advance()
          end do
       end do
-      solver(2)%volume%shortcuts = .false.
+      volumes = [corrector_ref_t(corrector_of(solver(1))), corrector_ref_t(corrector_of(solver(2)))]
+      volumes(2)%corrector%shortcuts = .false.
       do i = 1, 2
          associate (s => solver(i))
-            call s%volume%reset_grid()       ! the open volumes measured again, each way
+            call volumes(i)%corrector%reset_grid()       ! the open volumes measured again, each way
             ! an application as the step makes it: prepare, the transfer (its stencils kept in 3-D), the rest
-            call s%volume%prepare(s%domain, s%grid, s%constraints, s%particles, int(s%volume%interval, i8))
+            call volumes(i)%corrector%prepare(s%domain, s%grid, s%constraints, s%particles, &
+                                              int(volumes(i)%corrector%interval, i8))
             call particles_to_grid(s%grid, s%particles, s%gravity, stencils=s%stencils)
-            call s%volume%measure_excess(s%domain, s%grid, s%constraints, s%particles, s%stencils)
+            call volumes(i)%corrector%measure_excess(s%domain, s%grid, s%constraints, s%particles, s%stencils)
          end associate
       end do
-      call assertTrue(solver(1)%volume%shifting_now .and. solver(1)%volume%surface_model, label//': an application')
+      call assertTrue(volumes(1)%corrector%shifting_now .and. volumes(1)%corrector%surface_model, label//': an application')
       n = solver(1)%particles%count
       largest = 0.0_rp
       difference = 0.0_rp
       if (n > 0) then
-         largest = maxval(abs(solver(1)%volume%shift(:, 1:n)))
-         difference(1) = maxval(abs(solver(1)%volume%shift(:, 1:n) - solver(2)%volume%shift(:, 1:n)))
+         largest = maxval(abs(volumes(1)%corrector%shift(:, 1:n)))
+         difference(1) = maxval(abs(volumes(1)%corrector%shift(:, 1:n) - volumes(2)%corrector%shift(:, 1:n)))
       end if
-      difference(2) = maxval(abs(solver(1)%volume%open_volume - solver(2)%volume%open_volume))
-      difference(3) = maxval(abs(solver(1)%volume%fluid_volume - solver(2)%volume%fluid_volume))
-      difference(7) = maxval(abs(solver(1)%volume%surface_height - solver(2)%volume%surface_height))
+      difference(2) = maxval(abs(volumes(1)%corrector%open_volume - volumes(2)%corrector%open_volume))
+      difference(3) = maxval(abs(volumes(1)%corrector%fluid_volume - volumes(2)%corrector%fluid_volume))
+      difference(7) = maxval(abs(volumes(1)%corrector%surface_height - volumes(2)%corrector%surface_height))
       ! supports cut by walls, and open supports the surface cuts (the closed form's)
-      associate (v => solver(1)%volume)
+      associate (v => volumes(1)%corrector)
          cut_counts = [count(.not. v%fully_open), &
                        count(v%fully_open .and. v%fluid_volume > 0.0_rp .and. v%fluid_volume < v%open_volume)]
       end associate
@@ -343,7 +368,8 @@ contains
    !> and against the layer's top.
    subroutine test_height_function_skips_exactly(comm)
       type(MPI_Comm), intent(in) :: comm
-      type(solver_t) :: solver(2)
+      type(solver_t), target :: solver(2)
+      type(corrector_ref_t) :: volumes(2)
       type(scene_t) :: scene
       type(status_t) :: status
       integer, allocatable :: dest(:)
@@ -358,20 +384,22 @@ contains
          call assertTrue(status%ok, trim(status%message))
          call solver(i)%advance()             ! sorted by cell: the rows of cells bottom up
       end do
-      solver(2)%volume%shortcuts = .false.
+      volumes = [corrector_ref_t(corrector_of(solver(1))), corrector_ref_t(corrector_of(solver(2)))]
+      volumes(2)%corrector%shortcuts = .false.
       n = solver(1)%particles%count
       dest = mirror_swaps(n, 37, 100)
       do i = 1, 2
          call solver(i)%particles%permute(dest)
          associate (s => solver(i))
             ! an application as the step makes it (the heights come after the transfer)
-            call s%volume%prepare(s%domain, s%grid, s%constraints, s%particles, int(s%volume%interval, i8))
+            call volumes(i)%corrector%prepare(s%domain, s%grid, s%constraints, s%particles, &
+                                              int(volumes(i)%corrector%interval, i8))
             call particles_to_grid(s%grid, s%particles, s%gravity, stencils=s%stencils)
-            call s%volume%measure_excess(s%domain, s%grid, s%constraints, s%particles, s%stencils)
+            call volumes(i)%corrector%measure_excess(s%domain, s%grid, s%constraints, s%particles, s%stencils)
          end associate
       end do
-      associate (height => solver(1)%volume%surface_height)
-         difference = maxval(abs(height - solver(2)%volume%surface_height))
+      associate (height => volumes(1)%corrector%surface_height)
+         difference = maxval(abs(height - volumes(2)%corrector%surface_height))
          ! the bins over the layer (3.0 m of the grid's 3.0 m: all of them) at its top, 0.4 m
          error = maxval(abs(height - 0.4_rp))
       end associate

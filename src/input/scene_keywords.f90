@@ -1,0 +1,46 @@
+!> The keywords each scene variable with a fixed set of values accepts (docs/input.md), in one place for
+!> the reader (which canonicalises their spelling), the validation and the components that act on them.
+module scene_keywords
+   use scene_description, only: wall_none, wall_slip, wall_no_slip, wall_friction, motion_none, motion_solitary_wave, &
+                                motion_table, model_newtonian_fluid, model_linear_elastic, model_rigid, &
+                                gauge_pressure, gauge_level, gauge_connected_level, gauge_velocity, &
+                                gauge_wall_pressure
+   implicit none
+   private
+
+   !> Accepted `&material stabilization=` keywords in their canonical spelling (compared without case).
+   character(len=*), parameter, public :: stabilization_keywords(*) = [character(len=5) :: 'none', 'C0', 'NB', 'FOAL1']
+   !> Accepted `&material oscillation_rule=` and `smoothed_variables=` keywords (FOAL1 options).
+   character(len=*), parameter, public :: oscillation_rule_keywords(*) = [character(len=3) :: 'OR', 'AND']
+   character(len=*), parameter, public :: smoothed_variables_keywords(*) = [character(len=8) :: 'stress', 'pressure']
+   !> Accepted `&material volume_correction=` keywords (docs/volume-conservation.md).
+   character(len=*), parameter, public :: volume_correction_keywords(*) = &
+      [character(len=23) :: 'none', 'shifting', 'eos_relaxation', 'shifting+eos_relaxation']
+   !> Accepted `&grid shape_function=` keywords (stored lower case; docs/theory.md section 1.1).
+   character(len=*), parameter, public :: shape_function_keywords(*) = [character(len=8) :: 'linear', 'bspline2']
+   !> Accepted `&run update_scheme=` keywords (stored upper case).
+   character(len=*), parameter, public :: update_scheme_keywords(*) = [character(len=4) :: 'USL', 'MUSL']
+   !> Accepted `&run transfer=` keywords (stored lower case).
+   character(len=*), parameter, public :: transfer_keywords(*) = [character(len=8) :: 'flip_pic', 'apic']
+   !> Accepted `&wall motion=` keywords (stored lower case).
+   character(len=*), parameter, public :: motion_keywords(*) = [character(len=13) :: motion_none, &
+                                                                motion_solitary_wave, motion_table]
+
+   !> Accepted `&box_walls` keywords (stored lower case).
+   character(len=*), parameter, public :: wall_keywords(*) = [character(len=8) :: wall_none, wall_slip, wall_no_slip, &
+                                                              wall_friction]
+   !> Accepted `&structure condition=` keywords (stored lower case).
+   character(len=*), parameter, public :: wall_condition_keywords(*) = [character(len=8) :: wall_slip, wall_no_slip, &
+                                                                        wall_friction]
+   !> `&wall condition = 'free'`: a wall that constrains nothing and reports a zero load (free_condition).
+   character(len=*), parameter, public :: wall_free = 'free'
+   !> Accepted `&wall condition=` keywords.
+   character(len=*), parameter, public :: wall_group_condition_keywords(*) = [character(len=8) :: &
+                                                                              wall_condition_keywords, wall_free]
+   !> Accepted `&material model=` keywords (stored lower case).
+   character(len=*), parameter, public :: model_keywords(*) = &
+      [character(len=15) :: model_newtonian_fluid, model_linear_elastic, model_rigid]
+   !> Accepted `&gauge kind=` keywords (stored lower case).
+   character(len=*), parameter, public :: gauge_kind_keywords(*) = &
+      [character(len=15) :: gauge_pressure, gauge_level, gauge_connected_level, gauge_velocity, gauge_wall_pressure]
+end module scene_keywords

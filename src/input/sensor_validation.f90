@@ -1,0 +1,233 @@
+!> Checks of what a run measures: `&gauge` groups (kind, point, radius, the wall of a wall_pressure gauge)
+!> and the load namespace (the names of loads.csv: box sides that are walls, &wall, &inlet, &body,
+!> &structure, unique and resolved).
+module sensor_validation
+   use kinds, only: rp, name_len
+   use error_status, only: status_t
+   use scene_description, only: scene_t, grid_spec_t, gauge_spec_t, wall_none, motion_none, gauge_wall_pressure
+   use input_text, only: int_text, real_text, quoted_list, group_context, ordinal
+   use input_checks, only: check_real, check_name, given_or, name_detail, inside_tolerance
+   use scene_keywords, only: gauge_kind_keywords
+   use scene_memory, only: body_count, wall_count, structure_count, inlet_count
+   use scene_defaults, only: default_name, side_name
+   implicit none
+   private
+
+   public :: validate_gauge, validate_gauge_walls, validate_load_names
+
+   !> One name of the load namespace (box sides that are walls, &wall, &inlet, &body), for the
+   !> uniqueness check: the resolved name, whether the scene gave it, and how messages name its place.
+   type :: load_name_t
+      character(len=name_len) :: name = ''
+      logical :: given = .false.
+      character(len=:), allocatable :: owner      !< "the 2nd &wall", "the &box_walls side x_max"
+      character(len=:), allocatable :: where      !< group context of the variable that sets it
+      character(len=:), allocatable :: variable   !< "name", "x_max_name"
+   end type load_name_t
+
+contains
+
+   subroutine validate_gauge(gauges, g, grid, path, status)
+      type(gauge_spec_t), intent(in) :: gauges(:)
+      integer, intent(in) :: g
+      type(grid_spec_t), intent(in) :: grid
+      character(len=*), intent(in) :: path
+      type(status_t), intent(inout) :: status
+      character(len=:), allocatable :: where
+      real(rp) :: tolerance
+      integer :: k, other
+
+      associate (gauge => gauges(g))
+         if (len_trim(gauge%name) == 0) then
+            call status%fail(group_context(path, 'gauge', g)//': variable name is required')
+            return
+         end if
+         where = group_context(path, 'gauge', g, name_detail(gauge%name))
+         call check_name(where, 'name', gauge%name, status)
+         if (.not. status%ok) return
+         ! gauges.csv is a file of its own: gauge names need only differ from each other
+         do other = 1, g - 1
+            if (gauges(other)%name == gauge%name) then
+               call status%fail(where//": variable name '"//trim(gauge%name)//"' is already used by the "// &
+                                ordinal(other)//' &gauge')
+               return
+            end if
+         end do
+         if (all(gauge%kind /= gauge_kind_keywords)) then
+            call status%fail(where//': variable kind must be one of '//quoted_list(gauge_kind_keywords)//", got '"// &
+                             trim(gauge%kind)//"'")
+            return
+         end if
+         do k = 1, grid%dim
+            call check_real(where, 'point('//int_text(k)//')', gauge%point(k), status)
+         end do
+         call check_real(where, 'radius', gauge%radius, status, at_least=0.0_rp)
+         if (.not. status%ok) return
+         ! the scene box is axis-aligned in the world frame, whatever the grid's rotation (as for &inlet)
+         tolerance = inside_tolerance * grid%cell_size
+         do k = 1, grid%dim
+            if (gauge%point(k) < grid%origin(k) - tolerance .or. &
+                gauge%point(k) > grid%origin(k) + grid%extent(k) + tolerance) then
+               call status%fail(where//': variable point('//int_text(k)//') must lie in the scene box of &grid, '// &
+                                real_text(grid%origin(k))//' .. '//real_text(grid%origin(k) + grid%extent(k))// &
+                                ', got '//real_text(gauge%point(k)))
+               return
+            end if
+         end do
+      end associate
+   end subroutine validate_gauge
+
+   !> A wall_pressure gauge names the wall, box side or structure it lies on (its name in loads.csv, given or
+   !> default; that it lies on the surface is checked when the walls are built); the other kinds take no `wall`.
+   subroutine validate_gauge_walls(scene, path, status)
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: path
+      type(status_t), intent(inout) :: status
+      character(len=name_len), allocatable :: surfaces(:)
+      character(len=:), allocatable :: where
+      integer :: g
+      if (.not. allocated(scene%gauges)) return
+      surfaces = surface_names(scene)
+      do g = 1, size(scene%gauges)
+         associate (gauge => scene%gauges(g))
+            where = group_context(path, 'gauge', g, name_detail(gauge%name))
+            if (gauge%kind /= gauge_wall_pressure) then
+               if (len_trim(gauge%wall) > 0) then
+                  call status%fail(where//": variable wall is used by kind 'wall_pressure' only, got kind '"// &
+                                   trim(gauge%kind)//"'")
+                  return
+               end if
+               cycle
+            end if
+            if (len_trim(gauge%wall) == 0) then
+               call status%fail(where//": variable wall is required for kind 'wall_pressure' (the name of the "// &
+                                'wall, box side or structure the gauge lies on, as in loads.csv)')
+               return
+            end if
+            if (any(moving_surfaces(scene) == gauge%wall)) then
+               call status%fail(where//": variable wall names '"//trim(gauge%wall)//"', which moves (its "// &
+                                'motion): a wall_pressure gauge reads a fixed wall or structure')
+               return
+            end if
+            if (all(surfaces /= gauge%wall)) then
+               if (size(surfaces) == 0) then
+                  call status%fail(where//": variable wall names '"//trim(gauge%wall)//"', but the scene has no "// &
+                                   'wall, box side wall or structure')
+               else
+                  call status%fail(where//": variable wall must be the name of a wall, box side or structure, "// &
+                                   quoted_list(surfaces)//", got '"//trim(gauge%wall)//"'")
+               end if
+               return
+            end if
+         end associate
+      end do
+   end subroutine validate_gauge_walls
+
+   !> The names of the scene's constraining surfaces, as loads.csv names them: box sides that are walls,
+   !> &wall groups, &structure groups (given names or the defaults).
+   function surface_names(scene) result(names)
+      type(scene_t), intent(in) :: scene
+      character(len=name_len), allocatable :: names(:)
+      integer :: k, side, i
+      allocate (names(0))
+      do k = 1, 3
+         do side = 1, 2
+            if (scene%grid%wall(side, k) == wall_none) cycle
+            names = [names, given_or(scene%grid%wall_name(side, k), side_name(side, k))]
+         end do
+      end do
+      names = [names, (given_or(scene%walls(i)%name, default_name('wall', i)), i = 1, wall_count(scene))]
+      names = [names, (given_or(scene%structures(i)%name, default_name('structure', i)), i = 1, structure_count(scene))]
+   end function surface_names
+
+   !> The names of the &wall and &structure groups that move (a `motion` other than 'none').
+   function moving_surfaces(scene) result(names)
+      type(scene_t), intent(in) :: scene
+      character(len=name_len), allocatable :: names(:)
+      integer :: i
+      allocate (names(0))
+      do i = 1, wall_count(scene)
+         if (scene%walls(i)%motion%kind /= motion_none) names = [names, given_or(scene%walls(i)%name, default_name('wall', i))]
+      end do
+      do i = 1, structure_count(scene)
+         if (scene%structures(i)%motion%kind /= motion_none) &
+            names = [names, given_or(scene%structures(i)%name, default_name('structure', i))]
+      end do
+   end function moving_surfaces
+
+   !> The names of the walls (box sides that are walls, &wall), inlets and bodies are one namespace: the
+   !> columns of loads.csv and bodies.csv, and the labels of their plots. A name the scene gives must
+   !> differ from every other name, given or default (`wall_<k>`, `x_min`, `inlet_<k>`, `body_<k>`); the
+   !> message names the variable the scene wrote, so it is always a name the user can change.
+   subroutine validate_load_names(scene, path, status)
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: path
+      type(status_t), intent(inout) :: status
+      type(load_name_t), allocatable :: names(:)
+      character(len=:), allocatable :: owner
+      integer :: n, k, side, i, j
+
+      allocate (names(6 + wall_count(scene) + inlet_count(scene) + body_count(scene) + structure_count(scene)))
+      n = 0
+      do k = 1, 3
+         do side = 1, 2
+            if (scene%grid%wall(side, k) == wall_none) cycle
+            n = n + 1
+            call set_name(names(n), scene%grid%wall_name(side, k), side_name(side, k), &
+                          'the &box_walls side '//side_name(side, k), group_context(path, 'box_walls', 0), &
+                          side_name(side, k)//'_name')
+         end do
+      end do
+      do i = 1, wall_count(scene)
+         n = n + 1
+         call set_name(names(n), scene%walls(i)%name, default_name('wall', i), 'the '//ordinal(i)//' &wall', &
+                       group_context(path, 'wall', i, name_detail(scene%walls(i)%name)), 'name')
+      end do
+      do i = 1, inlet_count(scene)
+         n = n + 1
+         call set_name(names(n), scene%inlets(i)%name, default_name('inlet', i), 'the '//ordinal(i)//' &inlet', &
+                       group_context(path, 'inlet', i, "material '"//trim(scene%inlets(i)%material)//"'"), 'name')
+      end do
+      do i = 1, body_count(scene)
+         n = n + 1
+         call set_name(names(n), scene%bodies(i)%name, default_name('body', i), 'the '//ordinal(i)//' &body', &
+                       group_context(path, 'body', i, "material '"//trim(scene%bodies(i)%material)//"'"), 'name')
+      end do
+      do i = 1, structure_count(scene)
+         n = n + 1
+         call set_name(names(n), scene%structures(i)%name, default_name('structure', i), &
+                       'the '//ordinal(i)//' &structure', &
+                       group_context(path, 'structure', i, name_detail(scene%structures(i)%name)), 'name')
+      end do
+
+      ! Two default names never clash, so every clash involves a given name: report it there (the later
+      ! of two given names).
+      do j = 1, n
+         if (.not. names(j)%given) cycle
+         do i = 1, n
+            if (i == j .or. names(i)%name /= names(j)%name) cycle
+            if (names(i)%given .and. i > j) cycle
+            owner = names(i)%owner
+            if (.not. names(i)%given) owner = owner//' (its default name)'
+            call status%fail(names(j)%where//': variable '//names(j)%variable//" '"//trim(names(j)%name)// &
+                             "' is already used by "//owner)
+            return
+         end do
+      end do
+   end subroutine validate_load_names
+
+   !> One entry of the load namespace: `given` if not empty, else `default`.
+   subroutine set_name(entry, given, default, owner, where, variable)
+      type(load_name_t), intent(out) :: entry
+      character(len=*), intent(in) :: given, default, owner, where, variable
+      entry%given = len_trim(given) > 0
+      if (entry%given) then
+         entry%name = given
+      else
+         entry%name = default
+      end if
+      entry%owner = owner
+      entry%where = where
+      entry%variable = variable
+   end subroutine set_name
+end module sensor_validation

@@ -1,0 +1,59 @@
+!> The step's components (step_component) of a scene, in the order the step calls them at each stage:
+!> the inflow if the scene has inlets, the volume correction if a fluid selects one. A scene with neither
+!> has an empty list. A new component is one `if` here.
+module step_component_factory
+   use kinds, only: rp, i8
+   use scene_description, only: scene_t
+   use constraint_list, only: constraint_list_t
+   use step_component, only: step_component_t, component_slot_t
+   use phase_timers, only: phase_inflow, phase_volume_correction
+   use fluid_inflow, only: inflow_t, build_inlets
+   use volume_correction, only: volume_corrector_t
+   implicit none
+   private
+
+   public :: build_step_components
+
+contains
+
+   !> `first_id`: the first particle id after the bodies' (the inlets' ids follow); `gravity` in the grid
+   !> frame; `constraints` built from the same scene (the inlets' feeders are constraints).
+   subroutine build_step_components(scene, first_id, gravity, constraints, components)
+      type(scene_t), intent(in) :: scene
+      integer(i8), intent(in) :: first_id
+      real(rp), intent(in) :: gravity(3)
+      type(constraint_list_t), intent(in) :: constraints
+      type(component_slot_t), allocatable, intent(out) :: components(:)
+      type(inflow_t), allocatable :: inflow
+      type(volume_corrector_t), allocatable :: volume
+
+      allocate (components(0))
+      if (allocated(scene%inlets)) then
+         if (size(scene%inlets) > 0) then
+            allocate (inflow)
+            inflow%phase = phase_inflow
+            call build_inlets(scene, first_id, constraints, inflow%inlets)
+            call append(components, inflow)
+         end if
+      end if
+      allocate (volume)
+      call volume%init(scene, gravity)
+      if (volume%shifting .or. volume%relaxing) then
+         volume%phase = phase_volume_correction
+         call append(components, volume)
+      end if
+   end subroutine build_step_components
+
+   subroutine append(components, component)
+      type(component_slot_t), allocatable, intent(inout) :: components(:)
+      class(step_component_t), intent(in) :: component
+      type(component_slot_t), allocatable :: longer(:)
+      integer :: i
+      allocate (longer(size(components) + 1))
+      do i = 1, size(components)
+         call move_alloc(components(i)%component, longer(i)%component)
+      end do
+      allocate (longer(size(longer))%component, source=component)
+      call move_alloc(longer, components)
+   end subroutine append
+end module step_component_factory
