@@ -21,7 +21,10 @@
   8. --overwrite removes the three files of a previous run (the new scene has nothing to record);
   9. quadratic B-splines (&grid shape_function = 'bspline2', issue 16): checks 1 and 3 with the same
      tolerances (the walls also constrain the ghost nodes outside the box, whose impulse the loads count),
-     5 (restart byte for byte) and 6 (1, 2 and 4 ranks) on the same scenes.
+     5 (restart byte for byte) and 6 (1, 2 and 4 ranks) on the same scenes;
+ 10. a free wall (&wall condition = 'free', issue 51) through the water of check 4's dam break changes
+     nothing: the particles of every fields file bit for bit as without it, the other loads.csv columns
+     the same text, and its own columns exactly 0.
 
 Each check prints the measured value and its relative error. The scenes are in scenes/loads/ (their
 comments give the exact loads and, for check 2, why the set-up meets the tolerances). Without --long:
@@ -223,6 +226,36 @@ def check_conservation(checks, flotsam, scenes):
                      f"{name}: t = {ta:.3g} .. {tb:.3g} s: wall impulse ({impulse[0]:.10g}, {impulse[1]:.10g}) "
                      f"against -(dP - M g dt) = ({expected[0]:.10g}, {expected[1]:.10g}) N s/m, "
                      f"error {error:.1e} of M g dt (tolerance 1e-9)")
+
+
+def check_free_wall(checks, flotsam, scenes):
+    plain = flotsam.path("dam_break")
+    name = "dam_break_free_wall"
+    template = flotsam.path(name + "_template.nml")
+    with open(os.path.join(scenes, "loads", "dam_break.nml")) as f:
+        text = f.read()
+    with open(template, "w") as f:
+        f.write(text + "&wall name = 'free', point = 0.1, 0.0, normal = -1.0, 0.0, condition = 'free' /\n")
+    if not os.path.isdir(plain) or not run(checks, flotsam, template, name, 2):
+        return
+    fields = sorted(os.path.basename(f) for f in glob.glob(os.path.join(plain, "fields", "fields_*.h5")))
+    differing = []
+    for file in fields:
+        with h5py.File(os.path.join(plain, "fields", file)) as a, \
+             h5py.File(flotsam.path(name, "fields", file)) as b:
+            for dataset in ["position", "velocity", "density"]:
+                if not np.array_equal(a["particles"][dataset][()], b["particles"][dataset][()]):
+                    differing.append(f"{file}:{dataset}")
+    checks.check(len(fields) >= 3 and not differing,
+                 f"{name}: {len(fields)} fields files, particle positions, velocities and densities bit for bit "
+                 f"as without the free wall{': differ in ' + ', '.join(differing) if differing else ''}")
+    loads, reference = read(flotsam.path(name), "loads"), read(plain, "loads")
+    own = [c for c in loads.columns if c.startswith("free_")]
+    others = [c for c in loads.columns if c not in own]
+    checks.check(own and (loads[own] == 0.0).all().all(),
+                 f"{name}: its loads.csv columns {', '.join(own)} exactly 0 in all {len(loads)} rows")
+    checks.check(others == list(reference.columns) and loads[others].equals(reference),
+                 f"{name}: the other {len(others)} loads.csv columns equal those without the free wall")
 
 
 # --- 5 and 6: restart and ranks -------------------------------------------------------------------------
@@ -469,6 +502,7 @@ def main():
     check_hydrostatic_2d(checks, flotsam, scenes)
     check_hydrostatic_3d(checks, flotsam, scenes)
     check_conservation(checks, flotsam, scenes)
+    check_free_wall(checks, flotsam, scenes)
     two_ranks = check_restart(checks, flotsam_path, mpiexec, scenes)
     check_ranks(checks, flotsam, scenes, two_ranks)
     if two_ranks is not None:
