@@ -10,6 +10,10 @@
 !>   6. wall safeguard, inflow, migration to owning ranks, sort by (material, cell), next dt.
 !>   7. the active region follows the particles (active_region): a new layout when they near its edge.
 !> Everything runs in the grid's frame; the scene (world frame) is mapped into it once, in init.
+!> The step calls its parts through their interfaces: steps 1, 2 and 4 through the velocity fields
+!> (velocity_fields: one field, or one per body with &contact; USL or MUSL), 3 and 5 through the
+!> stabilizers, the walls and structures through the constraint list, and the features a scene may
+!> declare (inflow, volume correction) through the step components (step_component), stage by stage.
 module mpm_solver
    use kinds, only: rp, i8
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_Allgather, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_MIN, &
@@ -23,7 +27,7 @@ module mpm_solver
    use shape_functions, only: shape_function_kind, ghost_node_layers, shape_linear
    use load_balance, only: balanced_layout
    use particle_redistribution, only: redistribute_particles
-   use background_grid, only: grid_t, row_mass
+   use background_grid, only: grid_t
    use node_halo, only: sum_shared_nodes
    use particle_set, only: particle_set_t
    use tensor_layout, only: n_spin
@@ -44,10 +48,11 @@ module mpm_solver
    use wall_loads, only: wall_loads_t
    use fluid_gauges, only: fluid_gauges_t
    use body_motion, only: body_motion_t
-   use body_contact, only: contact_t, contact_field_rows
+   use body_contact, only: contact_field_rows
+   use velocity_fields, only: velocity_fields_t, transfer_state_t
+   use velocity_fields_factory, only: build_velocity_fields
    use rigid_bodies, only: rigid_set_t
    use world_frame, only: frame_t, place_grid
-   use grid_transfer, only: particles_to_grid, update_velocity_and_remap, grid_to_particles
    use stencil_cache, only: stencil_cache_t, forget_stencils
    use run_diagnostics, only: diagnostics_t, compute_diagnostics
    use active_region, only: scene_extent, particle_extent, cells_of_extent, guard_cells, box_needs_change, target_box, &
@@ -90,15 +95,14 @@ module mpm_solver
       real(rp), allocatable :: sensor_offset(:)
       type(fluid_gauges_t) :: gauges            !< the &gauge sensors (gauges.csv)
       type(body_motion_t) :: bodies             !< the solid bodies (bodies.csv)
-      type(contact_t) :: contact                !< velocity fields of the bodies in contact (&contact)
+      !> the grid's velocity field(s) and the transfers through them: one field, or with &contact one per body
+      class(velocity_fields_t), allocatable :: fields
       type(rigid_set_t) :: rigid                !< the rigid bodies (&material model = 'rigid')
       real(rp) :: time = 0.0_rp, dt = 0.0_rp
       integer(i8) :: step = 0
       integer :: lost_particles = 0             !< local count of particles that left the grid
       integer :: wall_corrections = 0           !< local count of safeguard corrections
       real(rp) :: mass_tolerance = 0.0_rp       !< nodes lighter than this carry no velocity
-      logical :: musl = .false.
-      real(rp), allocatable :: remapped_momentum(:, :)
       !> per material: its scheme forms the filtered rate of deformation from the nodal velocities, and G2P
       !> forms no particle rates (see materials_taking_rate_from_grid)
       logical, allocatable :: rate_from_grid(:)
@@ -149,7 +153,6 @@ contains
       dim = scene%grid%dim
       self%scene = scene
       self%run = scene%run
-      self%musl = scene%run%update_scheme == 'MUSL'
       call place_grid(scene%grid, frame, grid_origin, grid_cells)
       self%gravity = 0.0_rp
       self%gravity(1:dim) = frame%grid_vector(scene%gravity(1:dim))
@@ -180,7 +183,7 @@ contains
       if (.not. status%ok) return
       call self%gauges%init(scene, frame, self%gravity)
       call self%bodies%init(scene, self%materials, frame, self%gravity)
-      call self%contact%init(scene, self%bodies, size(self%materials))
+      call build_velocity_fields(scene, self%bodies, size(self%materials), self%fields)
       self%rate_from_grid = materials_taking_rate_from_grid(self)
 
       ! the rate of deformation and the spin are held per particle only for a material with a scheme, which
@@ -203,7 +206,7 @@ contains
       if (.not. status%ok) return
       call update_cells(self%grid, self%particles)
       call sort_by_material_and_cell(self%grid, self%particles)
-      call size_node_arrays(self)
+      call self%fields%size_nodes(self%grid)
       ! the rigid bodies' mass, inertia and motion from their particles (a restart reads them)
       call self%rigid%init(scene, self%bodies, self%grid, self%particles, self%domain%comm, measure=seed)
 
@@ -337,14 +340,6 @@ contains
       call agree_on_status(status, self%domain%comm)
    end subroutine check_structures_clear
 
-   !> Solver arrays over the local nodes (the grid's own arrays are sized by grid%init).
-   subroutine size_node_arrays(self)
-      type(solver_t), intent(inout) :: self
-      if (allocated(self%remapped_momentum)) deallocate (self%remapped_momentum)
-      if (self%musl) allocate (self%remapped_momentum(self%grid%dim, self%grid%node_count))
-      if (self%contact%active) call self%contact%size_nodes(self%grid, self%musl)
-   end subroutine size_node_arrays
-
    !> Rebalance if the largest rank holds more than rebalance_threshold times the mean number of
    !> particles per rank and another layout lowers that largest count (docs/theory.md section 6).
    !> A search that found no better layout is repeated only once the largest count has grown by the
@@ -412,7 +407,7 @@ contains
       end do
       call update_cells(self%grid, self%particles)
       if (.not. same_owners) call sort_by_material_and_cell(self%grid, self%particles)
-      call size_node_arrays(self)
+      call self%fields%size_nodes(self%grid)
    end subroutine solver_set_layout
 
    !> Lay the active region out around the particles wherever they are (all inside the grid), on this rank
@@ -463,12 +458,18 @@ contains
       real(rp) :: dt
       type(stage_context_t) :: context
       type(step_state_t) :: state
+      type(transfer_state_t) :: transfer
       logical :: smoothed(size(self%schemes))
 
       dt = self%dt
       state = step_state_t(domain=self%domain, grid=self%grid, particles=self%particles, &
                            constraints=self%constraints, stencils=self%stencils, time=self%time, dt=dt, &
                            step=self%step)
+      transfer = transfer_state_t(domain=self%domain, grid=self%grid, particles=self%particles, &
+                                  constraints=self%constraints, stencils=self%stencils, loads=self%loads, &
+                                  rigid=self%rigid, timers=self%timers, gravity=self%gravity, &
+                                  mass_tolerance=self%mass_tolerance, flip_fraction=self%run%flip_fraction, &
+                                  theta=self%run%theta)
       call self%timers%switch_to(phase_walls)
       call self%constraints%set_activity(self%time)
       call run_stage(self, stage_before_walls_move, state)
@@ -480,12 +481,8 @@ contains
       context%grid => self%grid
       context%stencils => self%stencils
       context%dt = dt
-      ! the rate's nodal velocities (rows 1:dim: with contact fields the common field's)
-      if (self%musl .and. self%contact%active) then
-         context%strain_velocity => self%contact%remapped
-      else if (self%musl) then
-         context%strain_velocity => self%remapped_momentum
-      end if
+      ! the rate's nodal velocities (MUSL; rows 1:dim: with contact fields the common field's)
+      context%strain_velocity => self%fields%strain_velocity()
       ! a scheme of a material no body or opened inlet supplies has no particles on any rank: skip it (its
       ! halo exchange and cell scans); a supplied one runs on every rank, with or without particles there
       do m = 1, size(self%schemes)
@@ -495,18 +492,12 @@ contains
       ! only one material supplied: all particles are its particles, on every rank
       context%sole_material = count([(material_supplied(self, m), m = 1, size(self%materials))]) == 1
       call self%timers%switch_to(phase_particles_to_grid)
-      if (self%contact%active) then
-         call self%contact%assign_fields(self%particles)
-         call particles_to_grid(self%grid, self%particles, self%gravity, self%contact%particle_field, &
-                                self%contact%field_row, stencils=self%stencils)
-      else
-         call particles_to_grid(self%grid, self%particles, self%gravity, stencils=self%stencils)
-      end if
+      call self%fields%to_grid(transfer)
       call self%timers%switch_to(phase_halo)
       call sum_shared_nodes(self%domain, self%grid, self%grid%accumulated)
       call run_stage(self, stage_grid_summed, state)
       call self%timers%switch_to(phase_grid_update)
-      call update_nodes(self, dt)
+      call self%fields%update_nodes(transfer, dt)
 
       call self%timers%switch_to(phase_stabilization)
       do m = 1, size(self%schemes)
@@ -516,9 +507,9 @@ contains
       end do
 
       call self%timers%switch_to(phase_grid_to_particles)
-      if (self%musl) call remap_velocities(self)
-      call move_particles(self, dt)
-      if (self%rigid%active) call self%rigid%finish()
+      call self%fields%remap(transfer)
+      call move_particles(self, transfer, dt)
+      call self%rigid%finish()
       call run_stage(self, stage_particles_moved, state)
 
       call self%timers%switch_to(phase_stabilization)
@@ -553,17 +544,7 @@ contains
       call self%timers%switch_to(phase_walls)
       ! the safeguard against the moving walls and structures where they are at the step's end
       call self%constraints%place(self%grid, self%time + dt)
-      if (self%contact%active) then
-         call self%constraints%keep_particles_inside(self%grid, self%particles, self%extent(:, 1), &
-                                                     self%extent(:, 2), self%wall_corrections, &
-                                                     self%loads%step_impulse, self%contact%particle_field, &
-                                                     self%contact%wall_friction(self%constraints%structure), &
-                                                     self%loads%field_impulse, skip=self%rigid%rigid_material)
-      else
-         call self%constraints%keep_particles_inside(self%grid, self%particles, self%extent(:, 1), &
-                                                     self%extent(:, 2), self%wall_corrections, &
-                                                     self%loads%step_impulse, skip=self%rigid%rigid_material)
-      end if
+      call self%fields%keep_particles_inside(transfer, self%extent(:, 1), self%extent(:, 2), self%wall_corrections)
       call self%timers%switch_to(phase_loads)
       call self%loads%end_step(self%constraints%loads)
       created = 0
@@ -666,9 +647,9 @@ contains
          if (.not. allocated(self%schemes(m)%scheme)) cycle
          select type (scheme => self%schemes(m)%scheme)
          class is (c0_anti_locking_t)    ! and FOAL1, which extends it
-            from_grid(m) = scheme%takes_rate_from_grid() .and. self%musl .and. self%grid%shape == shape_linear .and. &
-                           .not. self%materials(m)%model%uses_spin
-            if (self%contact%active) from_grid(m) = from_grid(m) .and. .not. self%contact%contact_material(m)
+            from_grid(m) = scheme%takes_rate_from_grid() .and. self%fields%musl .and. &
+                           self%grid%shape == shape_linear .and. .not. self%materials(m)%model%uses_spin .and. &
+                           .not. self%fields%has_fields_of(m)
          end select
       end do
    end function materials_taking_rate_from_grid
@@ -687,149 +668,6 @@ contains
       end do
    end function material_supplied
 
-   !> Step 2: v^n = P/m, v^{n+1} = v^n + dt f/m, walls, dv = v^{n+1} - v^n (contains the wall correction).
-   !> With contact, the same per velocity field and the contact between them (body_contact).
-   subroutine update_nodes(self, dt)
-      type(solver_t), intent(inout) :: self
-      real(rp), intent(in) :: dt
-      integer :: dim, mom, frc
-      real(rp), allocatable :: before_walls(:, :)
-      dim = self%grid%dim
-      if (self%contact%active) then
-         call self%contact%nodal_velocities(self%grid, dt, self%mass_tolerance)
-         call self%timers%switch_to(phase_walls)
-         call self%contact%apply_walls(self%constraints, self%grid, self%loads%step_impulse, self%loads%field_impulse)
-         call self%timers%switch_to(phase_grid_update)
-         if (self%rigid%active) call solve_rigid_bodies(self, dt)
-         return
-      end if
-      mom = self%grid%row_momentum
-      frc = self%grid%row_force
-      associate (acc => self%grid%accumulated, v => self%grid%velocity, dv => self%grid%velocity_increment)
-         if (dim == 2) then
-            call nodal_velocities_2d(size(acc, 1), self%grid%node_count, acc, mom, frc, dt, self%mass_tolerance, v, dv)
-         else
-            call nodal_velocities_3d(size(acc, 1), self%grid%node_count, acc, mom, frc, dt, self%mass_tolerance, v, dv)
-         end if
-         if (self%rigid%active) then
-            ! rigid bodies first, on the increments before the walls: a body meets the walls as a body
-            ! (rigid_bodies), and the walls then hold the other nodes only
-            dv = v - dv
-            call solve_rigid_bodies(self, dt)
-            before_walls = v
-            call self%timers%switch_to(phase_walls)
-            call self%constraints%constrain(dim, v, acc(row_mass, :), self%loads%step_impulse, &
-                                            skip=self%rigid%held)
-            call self%timers%switch_to(phase_grid_update)
-            dv = dv + (v - before_walls)
-         else
-            call self%timers%switch_to(phase_walls)
-            ! the walls' impulse on the nodes is the load on them (algorithms.md section 9.1); the MUSL re-map
-            ! below applies the walls again to velocities only, which moves no momentum
-            call self%constraints%constrain(dim, v, acc(row_mass, :), self%loads%step_impulse)
-            call self%timers%switch_to(phase_grid_update)
-            dv = v - dv
-         end if
-      end associate
-
-   contains
-
-      ! dv := v^n = P/m (for now), v := v^{n+1} = v^n + dt f/m before the walls; 0 where m is below the
-      ! tolerance. Per dimension (with one routine and the dimension a literal at the calls, only the loop
-      ! over the components vectorised), the node's rows read before the test: so the 2-D loop vectorises
-      ! (with sections of run-time length read under the test it stayed scalar). The same operations as before.
-      pure subroutine nodal_velocities_2d(rows, n, acc, mom, frc, dt, tolerance, v, dv)
-         integer, intent(in) :: rows, n, mom, frc
-         real(rp), intent(in) :: acc(rows, n), dt, tolerance
-         real(rp), intent(inout) :: v(2, n), dv(2, n)
-         real(rp) :: m, momentum(2), force(2)
-         integer :: i, k
-         do i = 1, n
-            m = acc(row_mass, i)
-            momentum = acc(mom:mom + 1, i)     ! read whatever the mass: the loads need no mask
-            force = acc(frc:frc + 1, i)
-            if (m > tolerance) then
-               do k = 1, 2
-                  dv(k, i) = momentum(k) / m
-                  v(k, i) = dv(k, i) + dt * force(k) / m
-               end do
-            else
-               do k = 1, 2
-                  dv(k, i) = 0.0_rp
-                  v(k, i) = 0.0_rp
-               end do
-            end if
-         end do
-      end subroutine nodal_velocities_2d
-
-      pure subroutine nodal_velocities_3d(rows, n, acc, mom, frc, dt, tolerance, v, dv)
-         integer, intent(in) :: rows, n, mom, frc
-         real(rp), intent(in) :: acc(rows, n), dt, tolerance
-         real(rp), intent(inout) :: v(3, n), dv(3, n)
-         real(rp) :: m, momentum(3), force(3)
-         integer :: i, k
-         do i = 1, n
-            m = acc(row_mass, i)
-            momentum = acc(mom:mom + 2, i)     ! read whatever the mass: the loads need no mask
-            force = acc(frc:frc + 2, i)
-            if (m > tolerance) then
-               do k = 1, 3
-                  dv(k, i) = momentum(k) / m
-                  v(k, i) = dv(k, i) + dt * force(k) / m
-               end do
-            else
-               do k = 1, 3
-                  dv(k, i) = 0.0_rp
-                  v(k, i) = 0.0_rp
-               end do
-            end if
-         end do
-      end subroutine nodal_velocities_3d
-   end subroutine update_nodes
-
-   !> The rigid bodies' step (rigid_bodies): each moves with the rigid projection of the nodal increments of
-   !> its nodes and the walls' contact; the impulses the walls give them count in the loads on rank 0.
-   !> With &contact on the fields' velocities (rigid_bodies). Collective.
-   subroutine solve_rigid_bodies(self, dt)
-      type(solver_t), intent(inout) :: self
-      real(rp), intent(in) :: dt
-      if (self%contact%active) then
-         call self%rigid%solve(self%domain, self%grid, self%particles, self%constraints, dt, self%domain%rank == 0, &
-                               self%loads%step_impulse, self%contact, self%loads%field_impulse)
-      else
-         call self%rigid%solve(self%domain, self%grid, self%particles, self%constraints, dt, self%domain%rank == 0, &
-                               self%loads%step_impulse)
-      end if
-   end subroutine solve_rigid_bodies
-
-   !> MUSL: update the particle velocities, then nodal velocities from their momentum, with walls.
-   subroutine remap_velocities(self)
-      type(solver_t), intent(inout) :: self
-      if (self%contact%active) then
-         call update_velocity_and_remap(self%grid, self%particles, self%run%flip_fraction, self%contact%remapped, &
-                                        self%contact%particle_field, self%contact%velocity, self%contact%increment, &
-                                        self%stencils)
-         if (self%rigid%active) call self%rigid%remap_correction(self%grid, self%particles, self%contact%remapped, &
-                                                                 self%contact%particle_field)
-         call self%timers%switch_to(phase_halo)
-         call sum_shared_nodes(self%domain, self%grid, self%contact%remapped)
-         call self%timers%switch_to(phase_grid_to_particles)
-         call self%contact%remapped_velocities(self%constraints, self%grid, self%mass_tolerance)
-         call self%timers%switch_to(phase_grid_to_particles)
-         return
-      end if
-      call update_velocity_and_remap(self%grid, self%particles, self%run%flip_fraction, self%remapped_momentum, &
-                                     stencils=self%stencils)
-      if (self%rigid%active) call self%rigid%remap_correction(self%grid, self%particles, self%remapped_momentum)
-      call self%timers%switch_to(phase_halo)
-      call sum_shared_nodes(self%domain, self%grid, self%remapped_momentum)
-      call self%timers%switch_to(phase_grid_to_particles)
-      call momenta_to_velocities(self%grid%accumulated, self%mass_tolerance, self%remapped_momentum)
-      call self%timers%switch_to(phase_walls)
-      call self%constraints%constrain(self%grid%dim, self%remapped_momentum)
-      call self%timers%switch_to(phase_grid_to_particles)
-   end subroutine remap_velocities
-
    !> Step 7 (G2P: rate of deformation, velocities with USL, positions), the volume correction's shifts,
    !> and step 5's stress update for the materials no scheme filters, material by material. The stress
    !> update of an unfiltered material follows G2P block by block, so that the block's rate of
@@ -838,8 +676,9 @@ contains
    !> results are those of three passes bit for bit. A filtered material's rate goes to
    !> particles%strain_rate for its scheme, and its stress update comes after the filter. self%extent
    !> gets the extent of the new positions.
-   subroutine move_particles(self, dt)
+   subroutine move_particles(self, transfer, dt)
       class(solver_t), intent(inout), target :: self
+      type(transfer_state_t), intent(inout) :: transfer
       real(rp), intent(in) :: dt
       integer, parameter :: block_size = 256    ! 8 (2-D) to 12 kB (3-D) of rate: stays in L1
       real(rp) :: rate(self%particles%n_sigma, block_size), extent(3, 2)
@@ -859,13 +698,11 @@ contains
          if (last < first) cycle
          uses_spin = self%materials(m)%model%uses_spin
          with_rate = .not. self%rate_from_grid(m)
-         if (self%rigid%active) then
-            if (self%rigid%rigid_material(m)) then
-               ! rigid bodies move as wholes (rigid_bodies): no G2P, no stress
-               call self%rigid%move(self%bodies, self%grid, self%particles, first, last, self%extent(1:dim, 1), &
-                                    self%extent(1:dim, 2))
-               cycle
-            end if
+         if (self%rigid%moves_material(m)) then
+            ! rigid bodies move as wholes (rigid_bodies): no G2P, no stress
+            call self%rigid%move(self%bodies, self%grid, self%particles, first, last, self%extent(1:dim, 1), &
+                                 self%extent(1:dim, 2))
+            cycle
          end if
          if (allocated(self%schemes(m)%scheme)) then
             call particle_kinematics(first, last, self%particles%strain_rate(:, first:last), &
@@ -906,35 +743,7 @@ contains
       subroutine particle_kinematics(first, last, d, w)
          integer, intent(in) :: first, last
          real(rp), intent(inout), contiguous :: d(:, :), w(:, :)
-         associate (run => self%run, contact => self%contact)
-            if (contact%active .and. self%musl) then
-               call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
-                                      update_velocity=.false., compute_strain=with_rate, update_position=.true., &
-                                      strain_velocity=contact%remapped, compute_spin=uses_spin, extent=extent, &
-                                      field=contact%particle_field, velocity=contact%velocity, &
-                                      increment=contact%increment, first=first, last=last, strain_rate=d, spin=w, &
-                                      stencils=self%stencils)
-            else if (contact%active) then
-               call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
-                                      update_velocity=.true., compute_strain=with_rate, update_position=.true., &
-                                      compute_spin=uses_spin, extent=extent, field=contact%particle_field, &
-                                      velocity=contact%velocity, increment=contact%increment, first=first, &
-                                      last=last, strain_rate=d, spin=w, &
-                                      stencils=self%stencils)
-            else if (self%musl) then
-               call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
-                                      update_velocity=.false., compute_strain=with_rate, update_position=.true., &
-                                      strain_velocity=self%remapped_momentum, compute_spin=uses_spin, &
-                                      extent=extent, first=first, last=last, strain_rate=d, spin=w, &
-                                      stencils=self%stencils)
-            else
-               call grid_to_particles(self%grid, self%particles, dt, run%flip_fraction, run%theta, &
-                                      update_velocity=.true., compute_strain=with_rate, update_position=.true., &
-                                      compute_spin=uses_spin, extent=extent, first=first, last=last, &
-                                      strain_rate=d, spin=w, &
-                                      stencils=self%stencils)
-            end if
-         end associate
+         call self%fields%kinematics(transfer, dt, first, last, with_rate, uses_spin, d, w, extent)
          self%extent(1:dim, 1) = min(self%extent(1:dim, 1), extent(1:dim, 1))
          self%extent(1:dim, 2) = max(self%extent(1:dim, 2), extent(1:dim, 2))
       end subroutine particle_kinematics
@@ -982,52 +791,6 @@ contains
          end if
       end do
    end subroutine local_speeds
-
-   !> momentum(:, i) / m_i at the nodes whose mass m_i = accumulated(row_mass, i) exceeds `tolerance`, 0
-   !> elsewhere (MUSL's re-mapped velocities). Per dimension without inner loops, so that it vectorises.
-   pure subroutine momenta_to_velocities(accumulated, tolerance, momentum)
-      real(rp), intent(in), contiguous :: accumulated(:, :)
-      real(rp), intent(in) :: tolerance
-      real(rp), intent(inout), contiguous :: momentum(:, :)
-      if (size(momentum, 1) == 2) then
-         call divide_2d(size(accumulated, 1), size(momentum, 2), accumulated, momentum)
-      else
-         call divide_3d(size(accumulated, 1), size(momentum, 2), accumulated, momentum)
-      end if
-   contains
-      pure subroutine divide_2d(rows, n, accumulated, momentum)
-         integer, intent(in) :: rows, n
-         real(rp), intent(in) :: accumulated(rows, n)
-         real(rp), intent(inout) :: momentum(2, n)
-         integer :: i
-         do i = 1, n
-            if (accumulated(row_mass, i) > tolerance) then
-               momentum(1, i) = momentum(1, i) / accumulated(row_mass, i)
-               momentum(2, i) = momentum(2, i) / accumulated(row_mass, i)
-            else
-               momentum(1, i) = 0.0_rp
-               momentum(2, i) = 0.0_rp
-            end if
-         end do
-      end subroutine divide_2d
-      pure subroutine divide_3d(rows, n, accumulated, momentum)
-         integer, intent(in) :: rows, n
-         real(rp), intent(in) :: accumulated(rows, n)
-         real(rp), intent(inout) :: momentum(3, n)
-         integer :: i
-         do i = 1, n
-            if (accumulated(row_mass, i) > tolerance) then
-               momentum(1, i) = momentum(1, i) / accumulated(row_mass, i)
-               momentum(2, i) = momentum(2, i) / accumulated(row_mass, i)
-               momentum(3, i) = momentum(3, i) / accumulated(row_mass, i)
-            else
-               momentum(1, i) = 0.0_rp
-               momentum(2, i) = 0.0_rp
-               momentum(3, i) = 0.0_rp
-            end if
-         end do
-      end subroutine divide_3d
-   end subroutine momenta_to_velocities
 
    !> The stable step `dt` from the speeds of all ranks (local_speeds, reduced), and a bound `speed`
    !> [m/s] on how fast the particles move: the largest signal speed c + |v| of the materials and open

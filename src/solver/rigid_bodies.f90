@@ -88,6 +88,7 @@ module rigid_bodies
       procedure :: remap_correction => rigid_remap_correction
       procedure :: move => rigid_move
       procedure :: finish => rigid_finish
+      procedure :: moves_material => rigid_moves_material
       procedure :: state => rigid_state
       procedure :: set_state => rigid_set_state
    end type rigid_set_t
@@ -728,7 +729,15 @@ contains
       end do
    end subroutine rigid_move
 
-   !> The end of the step: c := c^{n+1}, R := R^{n+1}.
+   !> True if material m's particles move as rigid bodies (move), not by G2P.
+   pure logical function rigid_moves_material(self, m) result(moves)
+      class(rigid_set_t), intent(in) :: self
+      integer, intent(in) :: m
+      moves = .false.
+      if (self%active) moves = self%rigid_material(m)
+   end function rigid_moves_material
+
+   !> The end of the step: c := c^{n+1}, R := R^{n+1} (nothing without bodies).
    subroutine rigid_finish(self)
       class(rigid_set_t), intent(inout) :: self
       integer :: b
