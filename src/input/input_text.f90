@@ -7,7 +7,7 @@ module input_text
    implicit none
    private
 
-   public :: lower_case, upper_case, int_text, real_text, real_list_text, ordinal, quoted_list
+   public :: lower_case, upper_case, int_text, real_text, real_list_text, ordinal, quoted_list, quoted, logical_text
    public :: keyword_index, canonical_keyword, group_context
 
    !> Integer to text, for default and 8-byte integers.
@@ -207,4 +207,24 @@ contains
          text = text//')'
       end if
    end function group_context
+
+   !> 'text' with an apostrophe doubled, trailing blanks removed.
+   pure function quoted(value) result(text)
+      character(len=*), intent(in) :: value
+      character(len=:), allocatable :: text
+      integer :: i
+      text = "'"
+      do i = 1, len_trim(value)
+         text = text//value(i:i)
+         if (value(i:i) == "'") text = text//"'"
+      end do
+      text = text//"'"
+   end function quoted
+
+   pure function logical_text(value) result(text)
+      logical, intent(in) :: value
+      character(len=:), allocatable :: text
+      text = merge('.true. ', '.false.', value)
+      text = trim(text)
+   end function logical_text
 end module input_text

@@ -4,8 +4,13 @@ module scene_description
    use kinds, only: rp, i8, path_len, name_len
    use shape_geometry, only: shape_t, box_corners
    use time_table, only: time_table_t
+   use gauge_group, only: gauge_spec_t, gauge_pressure, gauge_level, gauge_connected_level, gauge_velocity, &
+                          gauge_wall_pressure
    implicit none
    private
+
+   ! the groups whose variables live in their own module (src/input/groups/), named here for the scene's users
+   public :: gauge_spec_t, gauge_pressure, gauge_level, gauge_connected_level, gauge_velocity, gauge_wall_pressure
 
    !> The particle datasets `&run particle_fields` may name (position and connectivity are always written).
    character(len=*), parameter, public :: particle_field_names(*) = [character(len=11) :: 'velocity', 'mass', &
@@ -216,27 +221,6 @@ module scene_description
       real(rp), allocatable :: position(:, :)  !< (dim, n) [m]
       real(rp), allocatable :: volume(:)       !< (n) [m^3, m^2 in 2-D]
    end type body_points_t
-
-   !> Gauge kinds (`&gauge kind=`).
-   character(len=*), parameter, public :: gauge_pressure = 'pressure'
-   character(len=*), parameter, public :: gauge_level = 'level'
-   !> a level that sees only the water standing on the point: spray and falling jets above a gap are not read
-   character(len=*), parameter, public :: gauge_connected_level = 'connected_level'
-   character(len=*), parameter, public :: gauge_velocity = 'velocity'
-   !> the pressure a wall or structure takes over a patch of its surface, from its constraint's impulse
-   character(len=*), parameter, public :: gauge_wall_pressure = 'wall_pressure'
-
-   !> `&gauge`: a sensor of the fluid at a point, written to gauges.csv (docs/loads.md).
-   type, public :: gauge_spec_t
-      character(len=name_len) :: name = ''    !< column prefix in gauges.csv (required)
-      character(len=name_len) :: kind = ''    !< 'pressure', 'level', 'connected_level', 'velocity' or 'wall_pressure' (required)
-      real(rp) :: point(3) = 0.0_rp           !< where it measures, world frame [m] (required)
-      !> pressure, velocity: radius of the sphere (disc in 2-D) it averages over; level: half-width of the
-      !> column it looks in [m]; 0: resolved to the cell size (pressure, velocity) or half of it (level)
-      real(rp) :: radius = 0.0_rp
-      !> wall_pressure: the wall, box side or structure whose surface it lies on (its name in loads.csv)
-      character(len=name_len) :: wall = ''
-   end type gauge_spec_t
 
    !> `&contact`: bodies of two solid materials (or of one, against each other), or of a solid material and
    !> a `&structure`, in contact with their own velocity fields, separating and sliding with Coulomb

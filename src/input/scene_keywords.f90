@@ -2,9 +2,7 @@
 !> the reader (which canonicalises their spelling), the validation and the components that act on them.
 module scene_keywords
    use scene_description, only: wall_none, wall_slip, wall_no_slip, wall_friction, motion_none, motion_solitary_wave, &
-                                motion_table, model_newtonian_fluid, model_linear_elastic, model_rigid, &
-                                gauge_pressure, gauge_level, gauge_connected_level, gauge_velocity, &
-                                gauge_wall_pressure
+                                motion_table, model_newtonian_fluid, model_linear_elastic, model_rigid
    implicit none
    private
 
@@ -40,7 +38,4 @@ module scene_keywords
    !> Accepted `&material model=` keywords (stored lower case).
    character(len=*), parameter, public :: model_keywords(*) = &
       [character(len=15) :: model_newtonian_fluid, model_linear_elastic, model_rigid]
-   !> Accepted `&gauge kind=` keywords (stored lower case).
-   character(len=*), parameter, public :: gauge_kind_keywords(*) = &
-      [character(len=15) :: gauge_pressure, gauge_level, gauge_connected_level, gauge_velocity, gauge_wall_pressure]
 end module scene_keywords

@@ -13,18 +13,19 @@ module scene_reader
    use error_status, only: status_t
    use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
                                 inlet_spec_t, gauge_spec_t, structure_spec_t, contact_spec_t, motion_spec_t, &
-                                model_newtonian_fluid, &
-                                model_linear_elastic, model_rigid
+                                model_newtonian_fluid, model_linear_elastic, model_rigid
    use shape_geometry, only: shape_t, max_vertices, no_vertex
    use namelist_scan, only: namelist_file_t, namelist_group_t, scan_namelist_file
    use scene_validation, only: validate_scene
    use scene_defaults, only: resolve_scene, default_name
    use scene_memory, only: check_scene_memory
    use scene_keywords, only: stabilization_keywords, oscillation_rule_keywords
+   use scene_variables, only: variable_info_t, text_len, value_too_long, take_text
+   use gauge_group, only: gauge_variables, read_gauge_group
    use input_checks, only: name_detail
    use scene_broadcast, only: broadcast_scene
    use status_broadcast, only: broadcast_status
-   use input_text, only: lower_case, upper_case, int_text, ordinal, group_context, canonical_keyword
+   use input_text, only: lower_case, int_text, ordinal, group_context, canonical_keyword
    use point_file, only: load_body_points
    use inlet_table, only: load_inlet_tables
    use wall_motion, only: load_motion_tables
@@ -59,14 +60,8 @@ module scene_reader
    !> Groups a scene file must contain.
    character(len=*), parameter :: required_groups(*) = [character(len=8) :: 'run', 'grid', 'material']
 
-   !> The variables of every group: their kind names the expected value in messages.
-   type :: variable_info_t
-      character(len=9) :: group
-      character(len=26) :: name
-      character(len=7) :: kind          !< real, real3, reals (a list), integer, logical, string or string2 (two strings)
-      logical :: required
-   end type variable_info_t
-
+   !> The variables of every group (a group with a module of its own, src/input/groups/, gives its rows):
+   !> their kind names the expected value in messages.
    type(variable_info_t), parameter :: variables(*) = [ &
       variable_info_t('run', 'end_time', 'real', .true.), &
       variable_info_t('run', 'cfl', 'real', .false.), &
@@ -177,11 +172,7 @@ module scene_reader
       variable_info_t('inlet', 'end_time', 'real', .false.), &
       variable_info_t('inlet', 'particles_per_cell', 'integer', .false.), &
       variable_info_t('inlet', 'hydrostatic', 'logical', .false.), &
-      variable_info_t('gauge', 'name', 'string', .true.), &
-      variable_info_t('gauge', 'kind', 'string', .true.), &
-      variable_info_t('gauge', 'point', 'real3', .true.), &
-      variable_info_t('gauge', 'radius', 'real', .false.), &
-      variable_info_t('gauge', 'wall', 'string', .false.), &
+      gauge_variables, &
       variable_info_t('contact', 'between', 'string2', .true.), &
       variable_info_t('contact', 'friction', 'real', .false.), &
       variable_info_t('structure', 'name', 'string', .false.), &
@@ -208,11 +199,6 @@ module scene_reader
       variable_info_t('structure', 'motion_file', 'string', .false.), &
       variable_info_t('structure', 'motion_checksum', 'string', .false.)]
 
-   !> Namelist buffers of string values are longer than the scene's fields, so that a value too long
-   !> for its field is reported instead of cut.
-   integer, parameter :: text_len = 2*path_len
-   !> iostat of a group read whose string value is too long for its field (no run-time library uses it).
-   integer, parameter :: value_too_long = huge(1)
 
 contains
 
@@ -865,32 +851,6 @@ contains
       end select
    end subroutine read_group
 
-   !> After a successful read, store the string `value` of namelist variable `variable` in `target`,
-   !> folded to lower or upper case (adjusted left) when `fold` says so; a value longer than `target`
-   !> sets ios = value_too_long and a message naming the variable instead.
-   subroutine take_text(variable, value, target, ios, message, fold)
-      character(len=*), intent(in) :: variable, value
-      character(len=*), intent(inout) :: target
-      integer, intent(inout) :: ios
-      character(len=*), intent(inout) :: message
-      character(len=*), intent(in), optional :: fold
-      if (ios /= 0) return
-      if (len_trim(value) > len(target)) then
-         ios = value_too_long
-         message = 'variable '//variable//' must be at most '//int_text(len(target))//' characters long, got '// &
-                   int_text(len_trim(value))
-         return
-      end if
-      target = value
-      if (.not. present(fold)) return
-      select case (fold)
-      case ('lower')
-         target = lower_case(adjustl(value))
-      case ('upper')
-         target = upper_case(adjustl(value))
-      end select
-   end subroutine take_text
-
    !> `text` with every blank removed (a list of names reads the same with or without them).
    pure function without_blanks(text) result(packed)
       character(len=*), intent(in) :: text
@@ -1349,29 +1309,6 @@ contains
       spec%particles_per_cell = particles_per_cell
       spec%hydrostatic = hydrostatic
    end subroutine read_inlet_group
-
-   subroutine read_gauge_group(spec, ios, message, text)
-      type(gauge_spec_t), intent(inout) :: spec
-      integer, intent(out) :: ios
-      character(len=*), intent(inout) :: message
-      character(len=*), intent(in) :: text
-      character(len=text_len) :: name, kind, wall
-      real(rp) :: point(3), radius
-      namelist /gauge/ name, kind, point, radius, wall
-
-      name = spec%name
-      kind = spec%kind
-      point = spec%point
-      radius = spec%radius
-      wall = spec%wall
-      read (text, nml=gauge, iostat=ios, iomsg=message)
-      call take_text('name', name, spec%name, ios, message)
-      call take_text('kind', kind, spec%kind, ios, message, fold='lower')
-      call take_text('wall', wall, spec%wall, ios, message)
-      if (ios /= 0) return
-      spec%point = point
-      spec%radius = radius
-   end subroutine read_gauge_group
 
    subroutine read_contact_group(spec, ios, message, text)
       type(contact_spec_t), intent(inout) :: spec

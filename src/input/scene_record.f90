@@ -13,8 +13,8 @@ module scene_record
    use scene_description, only: scene_t, motion_spec_t
    use shape_geometry, only: no_vertex
    use scene_reader, only: known_groups, group_variables, entry_count
-   use input_text, only: int_text, real_text, real_list_text
-   use shape_geometry, only: no_vertex
+   use gauge_group, only: gauge_value
+   use input_text, only: int_text, real_text, real_list_text, quoted, logical_text
    implicit none
    private
 
@@ -107,7 +107,7 @@ contains
       case ('inlet')
          text = inlet_value(scene, k, name)
       case ('gauge')
-         text = gauge_value(scene, k, name)
+         text = gauge_value(scene%gauges(k), name)
       case ('contact')
          text = contact_value(scene, k, name)
       case ('structure')
@@ -418,29 +418,6 @@ contains
       end associate
    end function inlet_value
 
-   function gauge_value(scene, k, name) result(text)
-      type(scene_t), intent(in) :: scene
-      integer, intent(in) :: k
-      character(len=*), intent(in) :: name
-      character(len=:), allocatable :: text
-      associate (gauge => scene%gauges(k))
-         select case (name)
-         case ('name')
-            text = quoted(gauge%name)
-         case ('kind')
-            text = quoted(gauge%kind)
-         case ('point')
-            text = real_list_text(gauge%point)
-         case ('radius')
-            text = real_text(gauge%radius)
-         case ('wall')
-            text = quoted(gauge%wall)
-         case default
-            text = ''
-         end select
-      end associate
-   end function gauge_value
-
    function contact_value(scene, k, name) result(text)
       type(scene_t), intent(in) :: scene
       integer, intent(in) :: k
@@ -502,26 +479,6 @@ contains
          end select
       end associate
    end function structure_value
-
-   !> 'text' with an apostrophe doubled, trailing blanks removed.
-   pure function quoted(value) result(text)
-      character(len=*), intent(in) :: value
-      character(len=:), allocatable :: text
-      integer :: i
-      text = "'"
-      do i = 1, len_trim(value)
-         text = text//value(i:i)
-         if (value(i:i) == "'") text = text//"'"
-      end do
-      text = text//"'"
-   end function quoted
-
-   pure function logical_text(value) result(text)
-      logical, intent(in) :: value
-      character(len=:), allocatable :: text
-      text = merge('.true. ', '.false.', value)
-      text = trim(text)
-   end function logical_text
 
    !> The vertices as given, "x1, y1, x2, y2, ..." up to the first empty slot; none: a namelist null
    !> value "," (the variable keeps its default, no vertex).

@@ -20,7 +20,8 @@ module scene_validation
    use scene_defaults, only: find_material, find_structure, structure_name
    use body_validation, only: validate_body, check_body_has_particles
    use boundary_validation, only: validate_box_walls, validate_wall, validate_structure, validate_inlet
-   use sensor_validation, only: validate_gauge, validate_gauge_walls, validate_load_names
+   use sensor_validation, only: validate_gauge_walls, validate_load_names
+   use gauge_group, only: validate_gauge
    implicit none
    private
 
@@ -95,7 +96,8 @@ contains
       end if
       if (allocated(scene%gauges)) then
          do g = 1, size(scene%gauges)
-            call validate_gauge(scene%gauges, g, scene%grid, path, status)
+            call validate_gauge(scene%gauges, g, scene%grid%dim, scene%grid%origin, scene%grid%extent, &
+                                scene%grid%cell_size, path, status)
             if (.not. status%ok) return
          end do
       end if

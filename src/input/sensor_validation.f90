@@ -2,18 +2,17 @@
 !> and the load namespace (the names of loads.csv: box sides that are walls, &wall, &inlet, &body,
 !> &structure, unique and resolved).
 module sensor_validation
-   use kinds, only: rp, name_len
+   use kinds, only: name_len
    use error_status, only: status_t
-   use scene_description, only: scene_t, grid_spec_t, gauge_spec_t, wall_none, motion_none, gauge_wall_pressure
-   use input_text, only: int_text, real_text, quoted_list, group_context, ordinal
-   use input_checks, only: check_real, check_name, given_or, name_detail, inside_tolerance
-   use scene_keywords, only: gauge_kind_keywords
+   use scene_description, only: scene_t, wall_none, motion_none, gauge_wall_pressure
+   use input_text, only: quoted_list, group_context, ordinal
+   use input_checks, only: given_or, name_detail
    use scene_memory, only: body_count, wall_count, structure_count, inlet_count
    use scene_defaults, only: default_name, side_name
    implicit none
    private
 
-   public :: validate_gauge, validate_gauge_walls, validate_load_names
+   public :: validate_gauge_walls, validate_load_names
 
    !> One name of the load namespace (box sides that are walls, &wall, &inlet, &body), for the
    !> uniqueness check: the resolved name, whether the scene gave it, and how messages name its place.
@@ -26,56 +25,6 @@ module sensor_validation
    end type load_name_t
 
 contains
-
-   subroutine validate_gauge(gauges, g, grid, path, status)
-      type(gauge_spec_t), intent(in) :: gauges(:)
-      integer, intent(in) :: g
-      type(grid_spec_t), intent(in) :: grid
-      character(len=*), intent(in) :: path
-      type(status_t), intent(inout) :: status
-      character(len=:), allocatable :: where
-      real(rp) :: tolerance
-      integer :: k, other
-
-      associate (gauge => gauges(g))
-         if (len_trim(gauge%name) == 0) then
-            call status%fail(group_context(path, 'gauge', g)//': variable name is required')
-            return
-         end if
-         where = group_context(path, 'gauge', g, name_detail(gauge%name))
-         call check_name(where, 'name', gauge%name, status)
-         if (.not. status%ok) return
-         ! gauges.csv is a file of its own: gauge names need only differ from each other
-         do other = 1, g - 1
-            if (gauges(other)%name == gauge%name) then
-               call status%fail(where//": variable name '"//trim(gauge%name)//"' is already used by the "// &
-                                ordinal(other)//' &gauge')
-               return
-            end if
-         end do
-         if (all(gauge%kind /= gauge_kind_keywords)) then
-            call status%fail(where//': variable kind must be one of '//quoted_list(gauge_kind_keywords)//", got '"// &
-                             trim(gauge%kind)//"'")
-            return
-         end if
-         do k = 1, grid%dim
-            call check_real(where, 'point('//int_text(k)//')', gauge%point(k), status)
-         end do
-         call check_real(where, 'radius', gauge%radius, status, at_least=0.0_rp)
-         if (.not. status%ok) return
-         ! the scene box is axis-aligned in the world frame, whatever the grid's rotation (as for &inlet)
-         tolerance = inside_tolerance * grid%cell_size
-         do k = 1, grid%dim
-            if (gauge%point(k) < grid%origin(k) - tolerance .or. &
-                gauge%point(k) > grid%origin(k) + grid%extent(k) + tolerance) then
-               call status%fail(where//': variable point('//int_text(k)//') must lie in the scene box of &grid, '// &
-                                real_text(grid%origin(k))//' .. '//real_text(grid%origin(k) + grid%extent(k))// &
-                                ', got '//real_text(gauge%point(k)))
-               return
-            end if
-         end do
-      end associate
-   end subroutine validate_gauge
 
    !> A wall_pressure gauge names the wall, box side or structure it lies on (its name in loads.csv, given or
    !> default; that it lies on the surface is checked when the walls are built); the other kinds take no `wall`.
