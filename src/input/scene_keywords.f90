@@ -3,17 +3,14 @@
 module scene_keywords
    use scene_description, only: wall_none, wall_slip, wall_no_slip, wall_friction, motion_none, motion_solitary_wave, &
                                 motion_table, model_newtonian_fluid, model_linear_elastic, model_rigid
+   use material_group, only: stabilization_keywords, oscillation_rule_keywords, smoothed_variables_keywords, &
+                             volume_correction_keywords
    implicit none
    private
 
-   !> Accepted `&material stabilization=` keywords in their canonical spelling (compared without case).
-   character(len=*), parameter, public :: stabilization_keywords(*) = [character(len=5) :: 'none', 'C0', 'NB', 'FOAL1']
-   !> Accepted `&material oscillation_rule=` and `smoothed_variables=` keywords (FOAL1 options).
-   character(len=*), parameter, public :: oscillation_rule_keywords(*) = [character(len=3) :: 'OR', 'AND']
-   character(len=*), parameter, public :: smoothed_variables_keywords(*) = [character(len=8) :: 'stress', 'pressure']
-   !> Accepted `&material volume_correction=` keywords (docs/volume-conservation.md).
-   character(len=*), parameter, public :: volume_correction_keywords(*) = &
-      [character(len=23) :: 'none', 'shifting', 'eos_relaxation', 'shifting+eos_relaxation']
+   ! the keyword lists of a group with a module of its own (src/input/groups/), named here with the others
+   public :: stabilization_keywords, oscillation_rule_keywords, smoothed_variables_keywords, volume_correction_keywords
+
    !> Accepted `&grid shape_function=` keywords (stored lower case; docs/theory.md section 1.1).
    character(len=*), parameter, public :: shape_function_keywords(*) = [character(len=8) :: 'linear', 'bspline2']
    !> Accepted `&run update_scheme=` keywords (stored upper case).

@@ -9,23 +9,26 @@ module scene_reader
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_size
    use memory_budget, only: memory_budget_t, measure_memory_budget
-   use kinds, only: rp, i8, path_len
+   use kinds, only: rp, path_len
    use error_status, only: status_t
-   use scene_description, only: scene_t, run_control_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, &
-                                inlet_spec_t, gauge_spec_t, structure_spec_t, contact_spec_t, motion_spec_t, &
-                                model_newtonian_fluid, model_linear_elastic, model_rigid
+   use scene_description, only: scene_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, inlet_spec_t, &
+                                gauge_spec_t, structure_spec_t, contact_spec_t, motion_spec_t, model_newtonian_fluid, &
+                                model_linear_elastic, model_rigid
    use shape_geometry, only: shape_t, max_vertices, no_vertex
    use namelist_scan, only: namelist_file_t, namelist_group_t, scan_namelist_file
    use scene_validation, only: validate_scene
    use scene_defaults, only: resolve_scene, default_name
    use scene_memory, only: check_scene_memory
-   use scene_keywords, only: stabilization_keywords, oscillation_rule_keywords
    use scene_variables, only: variable_info_t, text_len, value_too_long, take_text
    use gauge_group, only: gauge_variables, read_gauge_group
+   use run_group, only: run_variables, read_run_group
+   use material_group, only: material_variables, read_material_group
+   use inlet_group, only: inlet_variables, read_inlet_group
+   use contact_group, only: contact_variables, read_contact_group
    use input_checks, only: name_detail
    use scene_broadcast, only: broadcast_scene
    use status_broadcast, only: broadcast_status
-   use input_text, only: lower_case, int_text, ordinal, group_context, canonical_keyword
+   use input_text, only: int_text, ordinal, group_context
    use point_file, only: load_body_points
    use inlet_table, only: load_inlet_tables
    use wall_motion, only: load_motion_tables
@@ -63,30 +66,7 @@ module scene_reader
    !> The variables of every group (a group with a module of its own, src/input/groups/, gives its rows):
    !> their kind names the expected value in messages.
    type(variable_info_t), parameter :: variables(*) = [ &
-      variable_info_t('run', 'end_time', 'real', .true.), &
-      variable_info_t('run', 'cfl', 'real', .false.), &
-      variable_info_t('run', 'dt', 'real', .false.), &
-      variable_info_t('run', 'output_interval', 'real', .false.), &
-      variable_info_t('run', 'output_dir', 'string', .false.), &
-      variable_info_t('run', 'overwrite', 'logical', .false.), &
-      variable_info_t('run', 'update_scheme', 'string', .false.), &
-      variable_info_t('run', 'transfer', 'string', .false.), &
-      variable_info_t('run', 'flip_fraction', 'real', .false.), &
-      variable_info_t('run', 'theta', 'real', .false.), &
-      variable_info_t('run', 'max_steps', 'integer', .false.), &
-      variable_info_t('run', 'progress_interval', 'real', .false.), &
-      variable_info_t('run', 'floor_size', 'real', .false.), &
-      variable_info_t('run', 'particle_output', 'logical', .false.), &
-      variable_info_t('run', 'grid_output', 'logical', .false.), &
-      variable_info_t('run', 'field_precision', 'string', .false.), &
-      variable_info_t('run', 'particle_fields', 'string', .false.), &
-      variable_info_t('run', 'checkpoint_interval_steps', 'integer', .false.), &
-      variable_info_t('run', 'checkpoint_interval_wall', 'real', .false.), &
-      variable_info_t('run', 'checkpoints_kept', 'integer', .false.), &
-      variable_info_t('run', 'speed_limit', 'real', .false.), &
-      variable_info_t('run', 'rebalance_threshold', 'real', .false.), &
-      variable_info_t('run', 'rebalance_interval', 'integer', .false.), &
-      variable_info_t('run', 'load_interval', 'real', .false.), &
+      run_variables, &
       variable_info_t('grid', 'dim', 'integer', .false.), &
       variable_info_t('grid', 'cell_size', 'real', .true.), &
       variable_info_t('grid', 'origin', 'real3', .false.), &
@@ -107,22 +87,7 @@ module scene_reader
       variable_info_t('box_walls', 'z_max_name', 'string', .false.), &
       variable_info_t('box_walls', 'friction', 'real', .false.), &
       variable_info_t('gravity', 'acceleration', 'real3', .false.), &
-      variable_info_t('material', 'name', 'string', .true.), &
-      variable_info_t('material', 'model', 'string', .true.), &
-      variable_info_t('material', 'density', 'real', .true.), &
-      variable_info_t('material', 'bulk_modulus', 'real', .false.), &
-      variable_info_t('material', 'viscosity', 'real', .false.), &
-      variable_info_t('material', 'youngs_modulus', 'real', .false.), &
-      variable_info_t('material', 'poisson_ratio', 'real', .false.), &
-      variable_info_t('material', 'stabilization', 'string', .false.), &
-      variable_info_t('material', 'volumetric_only', 'logical', .false.), &
-      variable_info_t('material', 'oscillation_rule', 'string', .false.), &
-      variable_info_t('material', 'gamma_max', 'real', .false.), &
-      variable_info_t('material', 'smoothed_variables', 'string', .false.), &
-      variable_info_t('material', 'cell_averaging', 'logical', .false.), &
-      variable_info_t('material', 'volume_correction', 'string', .false.), &
-      variable_info_t('material', 'shifting_coefficient', 'real', .false.), &
-      variable_info_t('material', 'eos_relaxation_rate', 'real', .false.), &
+      material_variables, &
       variable_info_t('body', 'name', 'string', .false.), &
       variable_info_t('body', 'material', 'string', .true.), &
       variable_info_t('body', 'shape', 'string', .false.), &
@@ -158,23 +123,9 @@ module scene_reader
       variable_info_t('wall', 'water_depth', 'real', .false.), &
       variable_info_t('wall', 'motion_file', 'string', .false.), &
       variable_info_t('wall', 'motion_checksum', 'string', .false.), &
-      variable_info_t('inlet', 'name', 'string', .false.), &
-      variable_info_t('inlet', 'material', 'string', .true.), &
-      variable_info_t('inlet', 'point', 'real3', .true.), &
-      variable_info_t('inlet', 'direction', 'real3', .true.), &
-      variable_info_t('inlet', 'height', 'real', .true.), &
-      variable_info_t('inlet', 'width', 'real', .false.), &
-      variable_info_t('inlet', 'velocity', 'real', .false.), &
-      variable_info_t('inlet', 'velocity_file', 'string', .false.), &
-      variable_info_t('inlet', 'velocity_checksum', 'string', .false.), &
-      variable_info_t('inlet', 'height_from_file', 'logical', .false.), &
-      variable_info_t('inlet', 'start_time', 'real', .false.), &
-      variable_info_t('inlet', 'end_time', 'real', .false.), &
-      variable_info_t('inlet', 'particles_per_cell', 'integer', .false.), &
-      variable_info_t('inlet', 'hydrostatic', 'logical', .false.), &
+      inlet_variables, &
       gauge_variables, &
-      variable_info_t('contact', 'between', 'string2', .true.), &
-      variable_info_t('contact', 'friction', 'real', .false.), &
+      contact_variables, &
       variable_info_t('structure', 'name', 'string', .false.), &
       variable_info_t('structure', 'shape', 'string', .false.), &
       variable_info_t('structure', 'centre', 'real3', .false.), &
@@ -198,7 +149,6 @@ module scene_reader
       variable_info_t('structure', 'motion_direction', 'real3', .false.), &
       variable_info_t('structure', 'motion_file', 'string', .false.), &
       variable_info_t('structure', 'motion_checksum', 'string', .false.)]
-
 
 contains
 
@@ -851,93 +801,6 @@ contains
       end select
    end subroutine read_group
 
-   !> `text` with every blank removed (a list of names reads the same with or without them).
-   pure function without_blanks(text) result(packed)
-      character(len=*), intent(in) :: text
-      character(len=len(text)) :: packed
-      integer :: i, n
-      packed = ''
-      n = 0
-      do i = 1, len_trim(text)
-         if (text(i:i) == ' ') cycle
-         n = n + 1
-         packed(n:n) = text(i:i)
-      end do
-   end function without_blanks
-
-   subroutine read_run_group(control, ios, message, text)
-      type(run_control_t), intent(inout) :: control
-      integer, intent(out) :: ios
-      character(len=*), intent(inout) :: message
-      character(len=*), intent(in) :: text
-      real(rp) :: end_time, cfl, dt, output_interval, flip_fraction, theta, progress_interval, floor_size, &
-                  checkpoint_interval_wall, speed_limit, rebalance_threshold, load_interval
-      character(len=text_len) :: output_dir, update_scheme, field_precision, particle_fields, transfer
-      logical :: overwrite, particle_output, grid_output
-      integer(i8) :: max_steps, checkpoint_interval_steps
-      integer :: checkpoints_kept, rebalance_interval
-      namelist /run/ end_time, cfl, dt, output_interval, output_dir, overwrite, update_scheme, transfer, &
-         flip_fraction, theta, max_steps, progress_interval, floor_size, particle_output, grid_output, &
-         checkpoint_interval_steps, checkpoint_interval_wall, checkpoints_kept, speed_limit, rebalance_threshold, &
-         rebalance_interval, load_interval, field_precision, particle_fields
-
-      end_time = control%end_time
-      cfl = control%cfl
-      dt = control%fixed_dt
-      output_interval = control%output_interval
-      output_dir = control%output_dir
-      overwrite = control%overwrite
-      update_scheme = control%update_scheme
-      transfer = control%transfer
-      ! huge marks "not assigned here": with APIC a flip_fraction the scene gives is refused, not ignored
-      flip_fraction = huge(1.0_rp)
-      theta = control%theta
-      max_steps = control%max_steps
-      progress_interval = control%progress_interval
-      floor_size = control%floor_size
-      particle_output = control%particle_output
-      grid_output = control%grid_output
-      field_precision = control%field_precision
-      particle_fields = control%particle_fields
-      checkpoint_interval_steps = control%checkpoint_interval_steps
-      checkpoint_interval_wall = control%checkpoint_interval_wall
-      checkpoints_kept = control%checkpoints_kept
-      speed_limit = control%speed_limit
-      rebalance_threshold = control%rebalance_threshold
-      rebalance_interval = control%rebalance_interval
-      load_interval = control%load_interval
-      read (text, nml=run, iostat=ios, iomsg=message)
-      call take_text('output_dir', output_dir, control%output_dir, ios, message)
-      call take_text('update_scheme', update_scheme, control%update_scheme, ios, message, fold='upper')
-      call take_text('transfer', transfer, control%transfer, ios, message, fold='lower')
-      call take_text('field_precision', field_precision, control%field_precision, ios, message, fold='lower')
-      call take_text('particle_fields', particle_fields, control%particle_fields, ios, message)
-      if (ios /= 0) return
-      control%end_time = end_time
-      control%cfl = cfl
-      control%fixed_dt = dt
-      control%output_interval = output_interval
-      control%overwrite = overwrite
-      if (flip_fraction < huge(1.0_rp) .or. .not. ieee_is_finite(flip_fraction)) then
-         control%flip_fraction = flip_fraction
-         control%flip_fraction_given = .true.
-      end if
-      control%theta = theta
-      control%max_steps = max_steps
-      control%progress_interval = progress_interval
-      control%floor_size = floor_size
-      control%particle_output = particle_output
-      control%grid_output = grid_output
-      control%particle_fields = without_blanks(lower_case(control%particle_fields))
-      control%checkpoint_interval_steps = checkpoint_interval_steps
-      control%checkpoint_interval_wall = checkpoint_interval_wall
-      control%checkpoints_kept = checkpoints_kept
-      control%speed_limit = speed_limit
-      control%rebalance_threshold = rebalance_threshold
-      control%rebalance_interval = rebalance_interval
-      control%load_interval = load_interval
-   end subroutine read_run_group
-
    subroutine read_grid_group(spec, ios, message, text)
       type(grid_spec_t), intent(inout) :: spec
       integer, intent(out) :: ios
@@ -1022,57 +885,6 @@ contains
       if (ios /= 0) return
       vector = acceleration
    end subroutine read_gravity_group
-
-   subroutine read_material_group(spec, ios, message, text)
-      type(material_spec_t), intent(inout) :: spec
-      integer, intent(out) :: ios
-      character(len=*), intent(inout) :: message
-      character(len=*), intent(in) :: text
-      character(len=text_len) :: name, model, stabilization, oscillation_rule, smoothed_variables, volume_correction
-      real(rp) :: density, bulk_modulus, viscosity, youngs_modulus, poisson_ratio, gamma_max, shifting_coefficient, &
-                  eos_relaxation_rate
-      logical :: volumetric_only, cell_averaging
-      namelist /material/ name, model, density, bulk_modulus, viscosity, youngs_modulus, poisson_ratio, stabilization, &
-         volumetric_only, oscillation_rule, gamma_max, smoothed_variables, cell_averaging, volume_correction, &
-         shifting_coefficient, eos_relaxation_rate
-
-      name = spec%name
-      model = spec%model
-      density = spec%density
-      bulk_modulus = spec%bulk_modulus
-      viscosity = spec%viscosity
-      youngs_modulus = spec%youngs_modulus
-      poisson_ratio = spec%poisson_ratio
-      stabilization = spec%stabilization
-      volumetric_only = spec%volumetric_only
-      oscillation_rule = spec%oscillation_rule
-      gamma_max = spec%gamma_max
-      smoothed_variables = spec%smoothed_variables
-      cell_averaging = spec%cell_averaging
-      volume_correction = spec%volume_correction
-      shifting_coefficient = spec%shifting_coefficient
-      eos_relaxation_rate = spec%eos_relaxation_rate
-      read (text, nml=material, iostat=ios, iomsg=message)
-      call take_text('name', name, spec%name, ios, message)
-      call take_text('model', model, spec%model, ios, message, fold='lower')
-      call take_text('stabilization', stabilization, spec%stabilization, ios, message)
-      call take_text('oscillation_rule', oscillation_rule, spec%oscillation_rule, ios, message)
-      call take_text('smoothed_variables', smoothed_variables, spec%smoothed_variables, ios, message, fold='lower')
-      call take_text('volume_correction', volume_correction, spec%volume_correction, ios, message, fold='lower')
-      if (ios /= 0) return
-      spec%density = density
-      spec%bulk_modulus = bulk_modulus
-      spec%viscosity = viscosity
-      spec%youngs_modulus = youngs_modulus
-      spec%poisson_ratio = poisson_ratio
-      spec%stabilization = canonical_keyword(adjustl(spec%stabilization), stabilization_keywords)
-      spec%volumetric_only = volumetric_only
-      spec%oscillation_rule = canonical_keyword(adjustl(spec%oscillation_rule), oscillation_rule_keywords)
-      spec%gamma_max = gamma_max
-      spec%cell_averaging = cell_averaging
-      spec%shifting_coefficient = shifting_coefficient
-      spec%eos_relaxation_rate = eos_relaxation_rate
-   end subroutine read_material_group
 
    subroutine read_body_group(spec, ios, message, text)
       type(body_spec_t), intent(inout) :: spec
@@ -1266,65 +1078,4 @@ contains
       if (ieee_is_finite(value)) given = value < no_vertex
    end function vertex_given
 
-   subroutine read_inlet_group(spec, ios, message, text)
-      type(inlet_spec_t), intent(inout) :: spec
-      integer, intent(out) :: ios
-      character(len=*), intent(inout) :: message
-      character(len=*), intent(in) :: text
-      character(len=text_len) :: name, material, velocity_file, velocity_checksum
-      real(rp) :: point(3), direction(3), height, width, velocity, start_time, end_time
-      integer :: particles_per_cell
-      logical :: hydrostatic, height_from_file
-      namelist /inlet/ name, material, point, direction, height, width, velocity, velocity_file, velocity_checksum, &
-         height_from_file, start_time, end_time, particles_per_cell, hydrostatic
-
-      name = spec%name
-      material = spec%material
-      point = spec%point
-      direction = spec%direction
-      height = spec%height
-      width = spec%width
-      velocity = spec%velocity
-      velocity_file = spec%velocity_file
-      velocity_checksum = spec%velocity_checksum
-      height_from_file = spec%height_from_file
-      start_time = spec%start_time
-      end_time = spec%end_time
-      particles_per_cell = spec%particles_per_cell
-      hydrostatic = spec%hydrostatic
-      read (text, nml=inlet, iostat=ios, iomsg=message)
-      call take_text('name', name, spec%name, ios, message)
-      call take_text('material', material, spec%material, ios, message)
-      call take_text('velocity_file', velocity_file, spec%velocity_file, ios, message)
-      call take_text('velocity_checksum', velocity_checksum, spec%velocity_checksum, ios, message, fold='lower')
-      if (ios /= 0) return
-      spec%point = point
-      spec%direction = direction
-      spec%height = height
-      spec%width = width
-      spec%velocity = velocity
-      spec%height_from_file = height_from_file
-      spec%start_time = start_time
-      spec%end_time = end_time
-      spec%particles_per_cell = particles_per_cell
-      spec%hydrostatic = hydrostatic
-   end subroutine read_inlet_group
-
-   subroutine read_contact_group(spec, ios, message, text)
-      type(contact_spec_t), intent(inout) :: spec
-      integer, intent(out) :: ios
-      character(len=*), intent(inout) :: message
-      character(len=*), intent(in) :: text
-      character(len=text_len) :: between(2)
-      real(rp) :: friction
-      namelist /contact/ between, friction
-
-      between = spec%between
-      friction = spec%friction
-      read (text, nml=contact, iostat=ios, iomsg=message)
-      call take_text('between', between(1), spec%between(1), ios, message)
-      call take_text('between', between(2), spec%between(2), ios, message)
-      if (ios /= 0) return
-      spec%friction = friction
-   end subroutine read_contact_group
 end module scene_reader

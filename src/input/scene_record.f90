@@ -14,6 +14,10 @@ module scene_record
    use shape_geometry, only: no_vertex
    use scene_reader, only: known_groups, group_variables, entry_count
    use gauge_group, only: gauge_value
+   use run_group, only: run_value
+   use material_group, only: material_value
+   use inlet_group, only: inlet_value
+   use contact_group, only: contact_value
    use input_text, only: int_text, real_text, real_list_text, quoted, logical_text
    implicit none
    private
@@ -90,7 +94,7 @@ contains
       character(len=:), allocatable :: text
       select case (group)
       case ('run')
-         text = run_value(scene, name)
+         text = run_value(scene%run, name)
       case ('grid')
          text = grid_value(scene, name)
       case ('box_walls')
@@ -99,81 +103,23 @@ contains
          text = ''
          if (name == 'acceleration') text = real_list_text(scene%gravity)
       case ('material')
-         text = material_value(scene, k, name)
+         text = material_value(scene%materials(k), name)
       case ('body')
          text = body_value(scene, k, name)
       case ('wall')
          text = wall_value(scene, k, name)
       case ('inlet')
-         text = inlet_value(scene, k, name)
+         text = inlet_value(scene%inlets(k), name)
       case ('gauge')
          text = gauge_value(scene%gauges(k), name)
       case ('contact')
-         text = contact_value(scene, k, name)
+         text = contact_value(scene%contacts(k), name)
       case ('structure')
          text = structure_value(scene, k, name)
       case default
          text = ''
       end select
    end function value_text
-
-   function run_value(scene, name) result(text)
-      type(scene_t), intent(in) :: scene
-      character(len=*), intent(in) :: name
-      character(len=:), allocatable :: text
-      associate (run => scene%run)
-         select case (name)
-         case ('end_time')
-            text = real_text(run%end_time)
-         case ('cfl')
-            text = real_text(run%cfl)
-         case ('dt')
-            text = real_text(run%fixed_dt)
-         case ('output_interval')
-            text = real_text(run%output_interval)
-         case ('output_dir')
-            text = quoted(run%output_dir)
-         case ('update_scheme')
-            text = quoted(run%update_scheme)
-         case ('transfer')
-            text = quoted(run%transfer)
-         case ('flip_fraction')
-            text = real_text(run%flip_fraction)
-         case ('theta')
-            text = real_text(run%theta)
-         case ('max_steps')
-            text = int_text(run%max_steps)
-         case ('progress_interval')
-            text = real_text(run%progress_interval)
-         case ('floor_size')
-            text = real_text(run%floor_size)
-         case ('particle_output')
-            text = logical_text(run%particle_output)
-         case ('grid_output')
-            text = logical_text(run%grid_output)
-         case ('field_precision')
-            text = quoted(run%field_precision)
-         case ('particle_fields')
-            text = quoted(run%particle_fields)
-         case ('checkpoint_interval_steps')
-            text = int_text(run%checkpoint_interval_steps)
-         case ('checkpoint_interval_wall')
-            text = real_text(run%checkpoint_interval_wall)
-         case ('checkpoints_kept')
-            text = int_text(run%checkpoints_kept)
-         case ('speed_limit')
-            text = real_text(run%speed_limit)
-         case ('rebalance_threshold')
-            text = real_text(run%rebalance_threshold)
-         case ('rebalance_interval')
-            text = int_text(run%rebalance_interval)
-         case ('load_interval')
-            text = real_text(run%load_interval)
-         case default
-            text = ''
-         end select
-      end associate
-   end function run_value
 
    function grid_value(scene, name) result(text)
       type(scene_t), intent(in) :: scene
@@ -222,51 +168,6 @@ contains
          text = quoted(scene%grid%wall_name(side, axis))
       end if
    end function box_walls_value
-
-   function material_value(scene, k, name) result(text)
-      type(scene_t), intent(in) :: scene
-      integer, intent(in) :: k
-      character(len=*), intent(in) :: name
-      character(len=:), allocatable :: text
-      associate (material => scene%materials(k))
-         select case (name)
-         case ('name')
-            text = quoted(material%name)
-         case ('model')
-            text = quoted(material%model)
-         case ('density')
-            text = real_text(material%density)
-         case ('bulk_modulus')
-            text = real_text(material%bulk_modulus)
-         case ('viscosity')
-            text = real_text(material%viscosity)
-         case ('youngs_modulus')
-            text = real_text(material%youngs_modulus)
-         case ('poisson_ratio')
-            text = real_text(material%poisson_ratio)
-         case ('stabilization')
-            text = quoted(material%stabilization)
-         case ('volumetric_only')
-            text = logical_text(material%volumetric_only)
-         case ('oscillation_rule')
-            text = quoted(material%oscillation_rule)
-         case ('gamma_max')
-            text = real_text(material%gamma_max)
-         case ('smoothed_variables')
-            text = quoted(material%smoothed_variables)
-         case ('cell_averaging')
-            text = logical_text(material%cell_averaging)
-         case ('volume_correction')
-            text = quoted(material%volume_correction)
-         case ('shifting_coefficient')
-            text = real_text(material%shifting_coefficient)
-         case ('eos_relaxation_rate')
-            text = real_text(material%eos_relaxation_rate)
-         case default
-            text = ''
-         end select
-      end associate
-   end function material_value
 
    function body_value(scene, k, name) result(text)
       type(scene_t), intent(in) :: scene
@@ -376,64 +277,6 @@ contains
          text = ''
       end select
    end function motion_value
-
-   function inlet_value(scene, k, name) result(text)
-      type(scene_t), intent(in) :: scene
-      integer, intent(in) :: k
-      character(len=*), intent(in) :: name
-      character(len=:), allocatable :: text
-      associate (inlet => scene%inlets(k))
-         select case (name)
-         case ('name')
-            text = quoted(inlet%name)
-         case ('material')
-            text = quoted(inlet%material)
-         case ('point')
-            text = real_list_text(inlet%point)
-         case ('direction')
-            text = real_list_text(inlet%direction)
-         case ('height')
-            text = real_text(inlet%height)
-         case ('width')
-            text = real_text(inlet%width)
-         case ('velocity')
-            text = real_text(inlet%velocity)
-         case ('velocity_file')
-            text = quoted(inlet%velocity_file)
-         case ('velocity_checksum')
-            text = quoted(inlet%velocity_checksum)
-         case ('height_from_file')
-            text = logical_text(inlet%height_from_file)
-         case ('start_time')
-            text = real_text(inlet%start_time)
-         case ('end_time')
-            text = real_text(inlet%end_time)
-         case ('particles_per_cell')
-            text = int_text(inlet%particles_per_cell)
-         case ('hydrostatic')
-            text = logical_text(inlet%hydrostatic)
-         case default
-            text = ''
-         end select
-      end associate
-   end function inlet_value
-
-   function contact_value(scene, k, name) result(text)
-      type(scene_t), intent(in) :: scene
-      integer, intent(in) :: k
-      character(len=*), intent(in) :: name
-      character(len=:), allocatable :: text
-      associate (contact => scene%contacts(k))
-         select case (name)
-         case ('between')
-            text = quoted(contact%between(1))//', '//quoted(contact%between(2))
-         case ('friction')
-            text = real_text(contact%friction)
-         case default
-            text = ''
-         end select
-      end associate
-   end function contact_value
 
    function structure_value(scene, k, name) result(text)
       type(scene_t), intent(in) :: scene
