@@ -10,7 +10,7 @@
 module wall_conditions
    use kinds, only: rp
    use scene_description, only: wall_no_slip, wall_friction
-   use scene_keywords, only: wall_free
+   use wall_group, only: wall_free
    use surface_condition, only: surface_condition_t, condition_traits_t, friction_node, unilateral_velocity
    use free_condition, only: free_condition_t
    implicit none

@@ -9,7 +9,7 @@ module body_validation
                              shape_sphere, shape_cylinder, shape_polygon, shape_extruded_polygon
    use body_lattice, only: has_points_file, box_corners_given, body_shape, count_particles, particle_spacing
    use input_checks, only: check_real, check_name, differs, inside_tolerance, axis_letter
-   use scene_defaults, only: find_material
+   use material_group, only: find_material
    implicit none
    private
 

@@ -3,72 +3,26 @@
 module boundary_validation
    use kinds, only: rp
    use error_status, only: status_t
-   use scene_description, only: scene_t, grid_spec_t, material_spec_t, wall_spec_t, inlet_spec_t, structure_spec_t, &
-                                opening_far_end, wall_none, has_velocity_file, motion_spec_t, wall_friction, &
-                                motion_none, motion_solitary_wave, motion_table, model_newtonian_fluid
+   use scene_description, only: scene_t, wall_spec_t, structure_spec_t, motion_spec_t, wall_friction, motion_none, &
+                                motion_solitary_wave, motion_table
    use input_text, only: int_text, real_text, quoted_list, group_context
    use shape_geometry, only: shape_t, shape_problem, shape_bounds, box_corners, max_vertices, shape_box, &
                              shape_circle, shape_sphere, shape_cylinder, shape_polygon, shape_extruded_polygon
    use wall_motion, only: wall_motion_t, prescribed_motion, box_excursion
    use input_checks, only: check_real, check_name, is_none, name_detail, inside_tolerance, axis_letter
-   use scene_keywords, only: motion_keywords, wall_keywords, wall_condition_keywords, wall_group_condition_keywords
-   use scene_defaults, only: side_name, find_material
+   use grid_group, only: wall_condition_keywords
+   use wall_group, only: wall_group_condition_keywords
+   use motion_spec, only: motion_keywords
    implicit none
    private
 
-   public :: validate_box_walls, validate_wall, validate_structure, validate_inlet
+   public :: validate_wall, validate_structure
 
    !> Largest solitary wave height over depth a wall may make (solitary waves break near A/h = 0.78;
    !> Goring's first-order stroke is poor beyond about 0.6).
    real(rp), parameter :: max_wave_ratio = 0.6_rp
 
 contains
-
-   !> `&box_walls`: each side's condition keyword (open in 2-D along z), the Coulomb coefficient of the
-   !> friction sides, and the names of the sides that are walls.
-   subroutine validate_box_walls(grid, path, status)
-      type(grid_spec_t), intent(in) :: grid
-      character(len=*), intent(in) :: path
-      type(status_t), intent(inout) :: status
-      character(len=:), allocatable :: where, variable
-      integer :: k, side
-
-      where = group_context(path, 'box_walls', 0)
-      do k = 1, 3
-         do side = 1, 2
-            variable = axis_letter(k)//merge('_min', '_max', side == 1)
-            if (all(grid%wall(side, k) /= wall_keywords)) then
-               call status%fail(where//': variable '//variable//' must be one of '//quoted_list(wall_keywords)// &
-                                ", got '"//trim(grid%wall(side, k))//"'")
-               return
-            end if
-            if (k > grid%dim .and. grid%wall(side, k) /= wall_none) then
-               call status%fail(where//': variable '//variable//" must be '"//wall_none//"' in 2-D (dim = 2), got '"// &
-                                trim(grid%wall(side, k))//"'")
-               return
-            end if
-         end do
-      end do
-      call check_real(where, 'friction', grid%wall_friction, status, at_least=0.0_rp)
-      if (status%ok .and. grid%wall_friction > 0.0_rp .and. all(grid%wall /= wall_friction)) &
-         call status%fail(where//': variable friction is the Coulomb coefficient of the sides whose condition is '''// &
-                          wall_friction//"', and no side is: give a side 'friction' or leave friction out")
-      if (.not. status%ok) return
-      ! a name labels the loads of a wall: an open side has none
-      do k = 1, 3
-         do side = 1, 2
-            variable = side_name(side, k)
-            if (len_trim(grid%wall_name(side, k)) == 0) cycle
-            if (grid%wall(side, k) == wall_none) then
-               call status%fail(where//': variable '//variable//"_name names side "//variable//", which is not a wall ("// &
-                                variable//" = '"//wall_none//"')")
-               return
-            end if
-            call check_name(where, variable//'_name', grid%wall_name(side, k), status)
-            if (.not. status%ok) return
-         end do
-      end do
-   end subroutine validate_box_walls
 
    subroutine validate_wall(wall, w, scene, path, status)
       type(wall_spec_t), intent(in) :: wall
@@ -327,89 +281,4 @@ contains
       end select
    end function shape_variables
 
-   subroutine validate_inlet(inlet, i, materials, grid, path, status)
-      type(inlet_spec_t), intent(in) :: inlet
-      integer, intent(in) :: i
-      type(material_spec_t), intent(in) :: materials(:)
-      type(grid_spec_t), intent(in) :: grid
-      character(len=*), intent(in) :: path
-      type(status_t), intent(inout) :: status
-      character(len=:), allocatable :: where
-      real(rp) :: far_end(3), tolerance
-      integer :: k, m, dim
-
-      dim = grid%dim
-      where = group_context(path, 'inlet', i, "material '"//trim(inlet%material)//"'")
-      call check_name(where, 'name', inlet%name, status)
-      if (.not. status%ok) return
-      m = find_material(materials, inlet%material)
-      if (m == 0) then
-         call status%fail(where//': variable material must name a declared &material, got '''//trim(inlet%material)//"'")
-         return
-      else if (materials(m)%model /= model_newtonian_fluid) then
-         call status%fail(where//": variable material must name a '"//model_newtonian_fluid//"' material, got '"// &
-                          trim(inlet%material)//"' (model '"//trim(materials(m)%model)//"')")
-         return
-      end if
-      do k = 1, dim
-         call check_real(where, 'point('//int_text(k)//')', inlet%point(k), status)
-         call check_real(where, 'direction('//int_text(k)//')', inlet%direction(k), status)
-      end do
-      call check_real(where, 'height', inlet%height, status, greater_than=0.0_rp)
-      if (dim == 3) call check_real(where, 'width', inlet%width, status, greater_than=0.0_rp)
-      if (has_velocity_file(inlet)) then
-         ! velocity = 0 is the default: a scene record writes it beside the file
-         if (abs(inlet%velocity) > 0.0_rp) then
-            call status%fail(where//': variables velocity and velocity_file exclude each other: give a constant '// &
-                             'speed or a time table of it, not both')
-            return
-         end if
-      else
-         if (len_trim(inlet%velocity_checksum) > 0) then
-            call status%fail(where//': variable velocity_checksum belongs to velocity_file, which is not given')
-            return
-         else if (inlet%height_from_file) then
-            call status%fail(where//': variable height_from_file needs velocity_file (a time table with a column '// &
-                             'height)')
-            return
-         else if (abs(inlet%velocity) == 0.0_rp) then
-            call status%fail(where//': give variable velocity (a constant inflow speed > 0) or velocity_file (a '// &
-                             'time table of t and velocity)')
-            return
-         end if
-         call check_real(where, 'velocity', inlet%velocity, status, greater_than=0.0_rp)
-      end if
-      call check_real(where, 'start_time', inlet%start_time, status, at_least=0.0_rp)
-      call check_real(where, 'end_time', inlet%end_time, status, greater_than=inlet%start_time)
-      if (.not. status%ok) return
-      if (inlet%particles_per_cell < 1) then
-         call status%fail(where//': variable particles_per_cell must be >= 1, got '//int_text(inlet%particles_per_cell))
-         return
-      end if
-      if (norm2(inlet%direction(1:dim)) < tiny(1.0_rp)**0.25_rp) then
-         call status%fail(where//': variable direction must not be zero: it is the direction of the inflow')
-         return
-      end if
-      if (dim == 3 .and. abs(inlet%direction(3)) > 0.0_rp) then
-         call status%fail(where//': variable direction(3) must be 0 (the opening spans height in the x-y plane and '// &
-                          'width along z), got '//real_text(inlet%direction(3)))
-         return
-      end if
-      ! both ends of the opening must lie in the scene box
-      far_end = opening_far_end(inlet, dim)
-      tolerance = inside_tolerance * grid%cell_size
-      do k = 1, dim
-         if (inlet%point(k) < grid%origin(k) - tolerance .or. &
-             inlet%point(k) > grid%origin(k) + grid%extent(k) + tolerance) then
-            call status%fail(where//': variable point('//int_text(k)//') must lie in the scene box of &grid, '// &
-                             real_text(grid%origin(k))//' .. '//real_text(grid%origin(k) + grid%extent(k))//', got '// &
-                             real_text(inlet%point(k)))
-         else if (far_end(k) < grid%origin(k) - tolerance .or. &
-                  far_end(k) > grid%origin(k) + grid%extent(k) + tolerance) then
-            call status%fail(where//': variables point, direction, height and width put the far end of the opening '// &
-                             'outside the scene box of &grid ('//axis_letter(k)//' = '//real_text(far_end(k))//')')
-         end if
-         if (.not. status%ok) return
-      end do
-   end subroutine validate_inlet
 end module boundary_validation

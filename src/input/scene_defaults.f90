@@ -3,15 +3,16 @@
 !> whole scene is read, and the look-ups of a group by name.
 module scene_defaults
    use kinds, only: rp, name_len
-   use scene_description, only: scene_t, material_spec_t, structure_spec_t, wall_none, structure_shape, gauge_level, &
+   use scene_description, only: scene_t, structure_spec_t, wall_none, structure_shape, gauge_level, &
                                 gauge_wall_pressure
    use input_text, only: int_text
    use shape_geometry, only: shape_t, polygon_vertices, polygon_area, shape_polygon, shape_extruded_polygon
-   use input_checks, only: axis_letter
+   use grid_group, only: side_name
+   use material_group, only: find_material
    implicit none
    private
 
-   public :: resolve_scene, default_name, side_name, find_material, find_structure, structure_name
+   public :: resolve_scene, default_name, find_structure, structure_name
 
 contains
 
@@ -136,27 +137,6 @@ contains
       character(len=:), allocatable :: name
       name = trim(group)//'_'//int_text(k)
    end function default_name
-
-   !> Name of a side of the scene box, and its `&box_walls` variable: `x_min` (side 1, axis 1) ... `z_max`.
-   pure function side_name(side, axis) result(name)
-      integer, intent(in) :: side, axis
-      character(len=5) :: name
-      name = axis_letter(axis)//merge('_min', '_max', side == 1)
-   end function side_name
-
-   !> Index of the material called `name` (exact match); 0 if there is none.
-   pure integer function find_material(materials, name) result(found)
-      type(material_spec_t), intent(in) :: materials(:)
-      character(len=*), intent(in) :: name
-      integer :: m
-      found = 0
-      do m = 1, size(materials)
-         if (materials(m)%name == name) then
-            found = m
-            return
-         end if
-      end do
-   end function find_material
 
    !> Index of the structure called `name` (its name or default name); 0 if there is none.
    pure integer function find_structure(structures, name) result(found)

@@ -6,21 +6,25 @@
 !> (which start from the scene's current values), the repeated groups, the checks that the base file
 !> gives every required variable, and finally `validate_scene` / `resolve_scene` on the whole scene.
 module scene_reader
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_size
    use memory_budget, only: memory_budget_t, measure_memory_budget
-   use kinds, only: rp, path_len
+   use kinds, only: path_len
    use error_status, only: status_t
-   use scene_description, only: scene_t, grid_spec_t, material_spec_t, body_spec_t, wall_spec_t, inlet_spec_t, &
-                                gauge_spec_t, structure_spec_t, contact_spec_t, motion_spec_t, model_newtonian_fluid, &
-                                model_linear_elastic, model_rigid
-   use shape_geometry, only: shape_t, max_vertices, no_vertex
+   use scene_description, only: scene_t, material_spec_t, body_spec_t, wall_spec_t, inlet_spec_t, gauge_spec_t, &
+                                structure_spec_t, contact_spec_t, model_newtonian_fluid, model_linear_elastic, &
+                                model_rigid
+   use shape_geometry, only: max_vertices
    use namelist_scan, only: namelist_file_t, namelist_group_t, scan_namelist_file
    use scene_validation, only: validate_scene
    use scene_defaults, only: resolve_scene, default_name
    use scene_memory, only: check_scene_memory
-   use scene_variables, only: variable_info_t, text_len, value_too_long, take_text
+   use scene_variables, only: variable_info_t, value_too_long
    use gauge_group, only: gauge_variables, read_gauge_group
+   use body_group, only: body_variables, read_body_group
+   use structure_group, only: structure_variables, read_structure_group
+   use wall_group, only: wall_variables, read_wall_group
+   use gravity_group, only: gravity_variables, read_gravity_group
+   use grid_group, only: grid_variables, read_grid_group, box_walls_variables, read_box_walls_group
    use run_group, only: run_variables, read_run_group
    use material_group, only: material_variables, read_material_group
    use inlet_group, only: inlet_variables, read_inlet_group
@@ -63,92 +67,20 @@ module scene_reader
    !> Groups a scene file must contain.
    character(len=*), parameter :: required_groups(*) = [character(len=8) :: 'run', 'grid', 'material']
 
-   !> The variables of every group (a group with a module of its own, src/input/groups/, gives its rows):
-   !> their kind names the expected value in messages.
+   !> The variables of every group, each group's rows from its module (src/input/groups/): their kind names
+   !> the expected value in messages.
    type(variable_info_t), parameter :: variables(*) = [ &
       run_variables, &
-      variable_info_t('grid', 'dim', 'integer', .false.), &
-      variable_info_t('grid', 'cell_size', 'real', .true.), &
-      variable_info_t('grid', 'origin', 'real3', .false.), &
-      variable_info_t('grid', 'extent', 'real3', .true.), &
-      variable_info_t('grid', 'rotation', 'real', .false.), &
-      variable_info_t('grid', 'shape_function', 'string', .false.), &
-      variable_info_t('box_walls', 'x_min', 'string', .false.), &
-      variable_info_t('box_walls', 'x_max', 'string', .false.), &
-      variable_info_t('box_walls', 'y_min', 'string', .false.), &
-      variable_info_t('box_walls', 'y_max', 'string', .false.), &
-      variable_info_t('box_walls', 'z_min', 'string', .false.), &
-      variable_info_t('box_walls', 'z_max', 'string', .false.), &
-      variable_info_t('box_walls', 'x_min_name', 'string', .false.), &
-      variable_info_t('box_walls', 'x_max_name', 'string', .false.), &
-      variable_info_t('box_walls', 'y_min_name', 'string', .false.), &
-      variable_info_t('box_walls', 'y_max_name', 'string', .false.), &
-      variable_info_t('box_walls', 'z_min_name', 'string', .false.), &
-      variable_info_t('box_walls', 'z_max_name', 'string', .false.), &
-      variable_info_t('box_walls', 'friction', 'real', .false.), &
-      variable_info_t('gravity', 'acceleration', 'real3', .false.), &
+      grid_variables, &
+      box_walls_variables, &
+      gravity_variables, &
       material_variables, &
-      variable_info_t('body', 'name', 'string', .false.), &
-      variable_info_t('body', 'material', 'string', .true.), &
-      variable_info_t('body', 'shape', 'string', .false.), &
-      variable_info_t('body', 'lower', 'real3', .false.), &
-      variable_info_t('body', 'upper', 'real3', .false.), &
-      variable_info_t('body', 'centre', 'real3', .false.), &
-      variable_info_t('body', 'size', 'real3', .false.), &
-      variable_info_t('body', 'rotation', 'real', .false.), &
-      variable_info_t('body', 'rotation_axis', 'real3', .false.), &
-      variable_info_t('body', 'radius', 'real', .false.), &
-      variable_info_t('body', 'axis', 'real3', .false.), &
-      variable_info_t('body', 'length', 'real', .false.), &
-      variable_info_t('body', 'vertices', 'reals', .false.), &
-      variable_info_t('body', 'z_range', 'reals', .false.), &
-      variable_info_t('body', 'points_file', 'string', .false.), &
-      variable_info_t('body', 'points_checksum', 'string', .false.), &
-      variable_info_t('body', 'particles_per_cell', 'integer', .false.), &
-      variable_info_t('body', 'velocity', 'real3', .false.), &
-      variable_info_t('body', 'angular_velocity', 'real3', .false.), &
-      variable_info_t('body', 'hydrostatic', 'logical', .false.), &
-      variable_info_t('body', 'free_surface_level', 'real', .false.), &
-      variable_info_t('wall', 'point', 'real3', .true.), &
-      variable_info_t('wall', 'normal', 'real3', .true.), &
-      variable_info_t('wall', 'lower', 'real3', .false.), &
-      variable_info_t('wall', 'upper', 'real3', .false.), &
-      variable_info_t('wall', 'condition', 'string', .false.), &
-      variable_info_t('wall', 'friction', 'real', .false.), &
-      variable_info_t('wall', 'name', 'string', .false.), &
-      variable_info_t('wall', 'moment_point', 'real3', .false.), &
-      variable_info_t('wall', 'motion', 'string', .false.), &
-      variable_info_t('wall', 'motion_start', 'real', .false.), &
-      variable_info_t('wall', 'wave_height', 'real', .false.), &
-      variable_info_t('wall', 'water_depth', 'real', .false.), &
-      variable_info_t('wall', 'motion_file', 'string', .false.), &
-      variable_info_t('wall', 'motion_checksum', 'string', .false.), &
+      body_variables, &
+      wall_variables, &
       inlet_variables, &
       gauge_variables, &
       contact_variables, &
-      variable_info_t('structure', 'name', 'string', .false.), &
-      variable_info_t('structure', 'shape', 'string', .false.), &
-      variable_info_t('structure', 'centre', 'real3', .false.), &
-      variable_info_t('structure', 'size', 'real3', .false.), &
-      variable_info_t('structure', 'rotation', 'real', .false.), &
-      variable_info_t('structure', 'rotation_axis', 'real3', .false.), &
-      variable_info_t('structure', 'radius', 'real', .false.), &
-      variable_info_t('structure', 'axis', 'real3', .false.), &
-      variable_info_t('structure', 'length', 'real', .false.), &
-      variable_info_t('structure', 'vertices', 'reals', .false.), &
-      variable_info_t('structure', 'z_range', 'reals', .false.), &
-      variable_info_t('structure', 'lower', 'real3', .false.), &
-      variable_info_t('structure', 'upper', 'real3', .false.), &
-      variable_info_t('structure', 'condition', 'string', .false.), &
-      variable_info_t('structure', 'friction', 'real', .false.), &
-      variable_info_t('structure', 'moment_point', 'real3', .false.), &
-      variable_info_t('structure', 'motion', 'string', .false.), &
-      variable_info_t('structure', 'motion_start', 'real', .false.), &
-      variable_info_t('structure', 'wave_height', 'real', .false.), &
-      variable_info_t('structure', 'water_depth', 'real', .false.), &
-      variable_info_t('structure', 'motion_direction', 'real3', .false.), &
-      variable_info_t('structure', 'motion_file', 'string', .false.), &
-      variable_info_t('structure', 'motion_checksum', 'string', .false.)]
+      structure_variables]
 
 contains
 
@@ -800,282 +732,5 @@ contains
          message = 'no namelist group &'//group
       end select
    end subroutine read_group
-
-   subroutine read_grid_group(spec, ios, message, text)
-      type(grid_spec_t), intent(inout) :: spec
-      integer, intent(out) :: ios
-      character(len=*), intent(inout) :: message
-      character(len=*), intent(in) :: text
-      integer :: dim
-      real(rp) :: cell_size, origin(3), extent(3), rotation
-      character(len=text_len) :: shape_function
-      namelist /grid/ dim, cell_size, origin, extent, rotation, shape_function
-
-      dim = spec%dim
-      cell_size = spec%cell_size
-      origin = spec%origin
-      extent = spec%extent
-      rotation = spec%rotation
-      shape_function = spec%shape_function
-      read (text, nml=grid, iostat=ios, iomsg=message)
-      if (ios /= 0) return
-      spec%dim = dim
-      spec%cell_size = cell_size
-      spec%origin = origin
-      spec%extent = extent
-      spec%rotation = rotation
-      call take_text('shape_function', shape_function, spec%shape_function, ios, message, fold='lower')
-   end subroutine read_grid_group
-
-   subroutine read_box_walls_group(spec, ios, message, text)
-      type(grid_spec_t), intent(inout) :: spec
-      integer, intent(out) :: ios
-      character(len=*), intent(inout) :: message
-      character(len=*), intent(in) :: text
-      character(len=text_len) :: x_min, x_max, y_min, y_max, z_min, z_max
-      character(len=text_len) :: x_min_name, x_max_name, y_min_name, y_max_name, z_min_name, z_max_name
-      character(len=text_len) :: sides(2, 3), names(2, 3)
-      character(len=*), parameter :: side_variables(2, 3) = reshape([character(len=5) :: 'x_min', 'x_max', &
-                                                                     'y_min', 'y_max', 'z_min', 'z_max'], [2, 3])
-      real(rp) :: friction
-      integer :: s, d
-      namelist /box_walls/ x_min, x_max, y_min, y_max, z_min, z_max, &
-         x_min_name, x_max_name, y_min_name, y_max_name, z_min_name, z_max_name, friction
-
-      x_min = spec%wall(1, 1)
-      x_max = spec%wall(2, 1)
-      y_min = spec%wall(1, 2)
-      y_max = spec%wall(2, 2)
-      z_min = spec%wall(1, 3)
-      z_max = spec%wall(2, 3)
-      x_min_name = spec%wall_name(1, 1)
-      x_max_name = spec%wall_name(2, 1)
-      y_min_name = spec%wall_name(1, 2)
-      y_max_name = spec%wall_name(2, 2)
-      z_min_name = spec%wall_name(1, 3)
-      z_max_name = spec%wall_name(2, 3)
-      friction = spec%wall_friction
-      read (text, nml=box_walls, iostat=ios, iomsg=message)
-      sides = reshape([character(len=text_len) :: x_min, x_max, y_min, y_max, z_min, z_max], [2, 3])
-      names = reshape([character(len=text_len) :: x_min_name, x_max_name, y_min_name, y_max_name, z_min_name, &
-                       z_max_name], [2, 3])
-      do d = 1, 3
-         do s = 1, 2
-            call take_text(side_variables(s, d), sides(s, d), spec%wall(s, d), ios, message, fold='lower')
-         end do
-      end do
-      do d = 1, 3
-         do s = 1, 2
-            call take_text(side_variables(s, d)//'_name', names(s, d), spec%wall_name(s, d), ios, message)
-         end do
-      end do
-      if (ios == 0) spec%wall_friction = friction
-   end subroutine read_box_walls_group
-
-   subroutine read_gravity_group(vector, ios, message, text)
-      real(rp), intent(inout) :: vector(3)
-      integer, intent(out) :: ios
-      character(len=*), intent(inout) :: message
-      character(len=*), intent(in) :: text
-      real(rp) :: acceleration(3)
-      namelist /gravity/ acceleration
-
-      acceleration = vector
-      read (text, nml=gravity, iostat=ios, iomsg=message)
-      if (ios /= 0) return
-      vector = acceleration
-   end subroutine read_gravity_group
-
-   subroutine read_body_group(spec, ios, message, text)
-      type(body_spec_t), intent(inout) :: spec
-      integer, intent(out) :: ios
-      character(len=*), intent(inout) :: message
-      character(len=*), intent(in) :: text
-      character(len=text_len) :: name, material, shape, points_file, points_checksum
-      real(rp) :: lower(3), upper(3), velocity(3), angular_velocity(3), free_surface_level, centre(3), size(3), &
-                  rotation, rotation_axis(3), radius, axis(3), length, vertices(2 * max_vertices), z_range(2)
-      integer :: particles_per_cell
-      logical :: hydrostatic
-      namelist /body/ name, material, shape, lower, upper, centre, size, rotation, rotation_axis, radius, axis, &
-         length, vertices, z_range, points_file, points_checksum, particles_per_cell, velocity, angular_velocity, &
-         hydrostatic, free_surface_level
-
-      name = spec%name
-      material = spec%material
-      shape = spec%shape%kind
-      lower = spec%lower
-      upper = spec%upper
-      call shape_to_locals(spec%shape, centre, size, rotation, rotation_axis, radius, axis, length, vertices, z_range)
-      points_file = spec%points_file
-      points_checksum = spec%points_checksum
-      particles_per_cell = spec%particles_per_cell
-      velocity = spec%velocity
-      angular_velocity = spec%angular_velocity
-      hydrostatic = spec%hydrostatic
-      free_surface_level = spec%free_surface_level
-      read (text, nml=body, iostat=ios, iomsg=message)
-      call take_text('name', name, spec%name, ios, message)
-      call take_text('material', material, spec%material, ios, message)
-      call take_text('shape', shape, spec%shape%kind, ios, message, fold='lower')
-      call take_text('points_file', points_file, spec%points_file, ios, message)
-      call take_text('points_checksum', points_checksum, spec%points_checksum, ios, message, fold='lower')
-      if (ios /= 0) return
-      spec%lower = lower
-      spec%upper = upper
-      call locals_to_shape(centre, size, rotation, rotation_axis, radius, axis, length, vertices, z_range, spec%shape)
-      spec%particles_per_cell = particles_per_cell
-      spec%velocity = velocity
-      spec%angular_velocity = angular_velocity
-      spec%hydrostatic = hydrostatic
-      spec%free_surface_level = free_surface_level
-   end subroutine read_body_group
-
-   subroutine read_wall_group(spec, ios, message, text)
-      type(wall_spec_t), intent(inout) :: spec
-      integer, intent(out) :: ios
-      character(len=*), intent(inout) :: message
-      character(len=*), intent(in) :: text
-      character(len=text_len) :: condition, name, motion, motion_file, motion_checksum
-      real(rp) :: point(3), normal(3), lower(3), upper(3), moment_point(3), friction, motion_start, wave_height, &
-                  water_depth, motion_direction(3)
-      namelist /wall/ point, normal, lower, upper, condition, friction, name, moment_point, motion, motion_start, &
-         wave_height, water_depth, motion_file, motion_checksum
-
-      point = spec%point
-      normal = spec%normal
-      lower = spec%lower
-      upper = spec%upper
-      condition = spec%condition
-      friction = spec%friction
-      name = spec%name
-      moment_point = spec%moment_point
-      call motion_to_locals(spec%motion, motion, motion_start, wave_height, water_depth, motion_direction, motion_file, &
-                            motion_checksum)
-      read (text, nml=wall, iostat=ios, iomsg=message)
-      call take_text('condition', condition, spec%condition, ios, message, fold='lower')
-      call take_text('name', name, spec%name, ios, message)
-      call take_motion(motion, motion_start, wave_height, water_depth, motion_direction, motion_file, motion_checksum, &
-                       spec%motion, ios, message)
-      if (ios /= 0) return
-      spec%point = point
-      spec%normal = normal
-      spec%lower = lower
-      spec%upper = upper
-      spec%friction = friction
-      spec%moment_point = moment_point
-   end subroutine read_wall_group
-
-   !> `vertices` is a flat list x1, y1, x2, y2, ...: a list that is given replaces the whole polygon (an
-   !> override with fewer vertices must not keep the old ones beyond it).
-   subroutine read_structure_group(spec, ios, message, text)
-      type(structure_spec_t), intent(inout) :: spec
-      integer, intent(out) :: ios
-      character(len=*), intent(inout) :: message
-      character(len=*), intent(in) :: text
-      character(len=text_len) :: name, shape, condition, motion, motion_file, motion_checksum
-      real(rp) :: centre(3), size(3), rotation, rotation_axis(3), radius, axis(3), length, vertices(2 * max_vertices), &
-                  z_range(2), lower(3), upper(3), friction, moment_point(3), motion_start, wave_height, water_depth, &
-                  motion_direction(3)
-      namelist /structure/ name, shape, centre, size, rotation, rotation_axis, radius, axis, length, vertices, z_range, &
-         lower, upper, condition, friction, moment_point, motion, motion_start, wave_height, water_depth, &
-         motion_direction, motion_file, motion_checksum
-
-      name = spec%name
-      shape = spec%shape%kind
-      call shape_to_locals(spec%shape, centre, size, rotation, rotation_axis, radius, axis, length, vertices, z_range)
-      lower = spec%lower
-      upper = spec%upper
-      condition = spec%condition
-      friction = spec%friction
-      moment_point = spec%moment_point
-      call motion_to_locals(spec%motion, motion, motion_start, wave_height, water_depth, motion_direction, motion_file, &
-                            motion_checksum)
-      read (text, nml=structure, iostat=ios, iomsg=message)
-      call take_text('name', name, spec%name, ios, message)
-      call take_text('shape', shape, spec%shape%kind, ios, message, fold='lower')
-      call take_text('condition', condition, spec%condition, ios, message, fold='lower')
-      call take_motion(motion, motion_start, wave_height, water_depth, motion_direction, motion_file, motion_checksum, &
-                       spec%motion, ios, message)
-      if (ios /= 0) return
-      call locals_to_shape(centre, size, rotation, rotation_axis, radius, axis, length, vertices, z_range, spec%shape)
-      spec%lower = lower
-      spec%upper = upper
-      spec%friction = friction
-      spec%moment_point = moment_point
-   end subroutine read_structure_group
-
-   !> The variables of a prescribed motion (`&wall`, `&structure`) as namelist variables.
-   pure subroutine motion_to_locals(spec, motion, motion_start, wave_height, water_depth, motion_direction, &
-                                    motion_file, motion_checksum)
-      type(motion_spec_t), intent(in) :: spec
-      character(len=*), intent(out) :: motion, motion_file, motion_checksum
-      real(rp), intent(out) :: motion_start, wave_height, water_depth, motion_direction(3)
-      motion = spec%kind
-      motion_start = spec%start
-      wave_height = spec%wave_height
-      water_depth = spec%water_depth
-      motion_direction = spec%direction
-      motion_file = spec%file
-      motion_checksum = spec%checksum
-   end subroutine motion_to_locals
-
-   !> The namelist variables read back into the motion (see motion_to_locals; take_text for the strings).
-   subroutine take_motion(motion, motion_start, wave_height, water_depth, motion_direction, motion_file, &
-                          motion_checksum, spec, ios, message)
-      character(len=*), intent(in) :: motion, motion_file, motion_checksum
-      real(rp), intent(in) :: motion_start, wave_height, water_depth, motion_direction(3)
-      type(motion_spec_t), intent(inout) :: spec
-      integer, intent(inout) :: ios
-      character(len=*), intent(inout) :: message
-      call take_text('motion', motion, spec%kind, ios, message, fold='lower')
-      call take_text('motion_file', motion_file, spec%file, ios, message)
-      call take_text('motion_checksum', motion_checksum, spec%checksum, ios, message, fold='lower')
-      if (ios /= 0) return
-      spec%start = motion_start
-      spec%wave_height = wave_height
-      spec%water_depth = water_depth
-      spec%direction = motion_direction
-   end subroutine take_motion
-
-   !> The numbers of a shape as the namelist variables of a group that takes one (&body, &structure). The
-   !> vertices start empty: a list that is read replaces the shape's whole list (an override with fewer
-   !> vertices leaves none of the old ones behind), a group without `vertices` keeps them (locals_to_shape).
-   pure subroutine shape_to_locals(shape, centre, size, rotation, rotation_axis, radius, axis, length, vertices, z_range)
-      type(shape_t), intent(in) :: shape
-      real(rp), intent(out) :: centre(3), size(3), rotation, rotation_axis(3), radius, axis(3), length, &
-                               vertices(2 * max_vertices), z_range(2)
-      centre = shape%centre
-      size = shape%size
-      rotation = shape%rotation
-      rotation_axis = shape%rotation_axis
-      radius = shape%radius
-      axis = shape%axis
-      length = shape%length
-      vertices = no_vertex
-      z_range = shape%z_range
-   end subroutine shape_to_locals
-
-   !> The namelist variables read back into the shape (see shape_to_locals; its kind is read as text).
-   pure subroutine locals_to_shape(centre, size, rotation, rotation_axis, radius, axis, length, vertices, z_range, shape)
-      real(rp), intent(in) :: centre(3), size(3), rotation, rotation_axis(3), radius, axis(3), length, &
-                              vertices(2 * max_vertices), z_range(2)
-      type(shape_t), intent(inout) :: shape
-      shape%centre = centre
-      shape%size = size
-      shape%rotation = rotation
-      shape%rotation_axis = rotation_axis
-      shape%radius = radius
-      shape%axis = axis
-      shape%length = length
-      if (any(vertex_given(vertices))) shape%vertices = reshape(vertices, [2, max_vertices])
-      shape%z_range = z_range
-   end subroutine locals_to_shape
-
-   !> A value of a vertex list that is not the 'none' marker (a NaN is given: validation reports it).
-   elemental logical function vertex_given(value) result(given)
-      real(rp), intent(in) :: value
-      given = .true.
-      if (ieee_is_finite(value)) given = value < no_vertex
-   end function vertex_given
 
 end module scene_reader

@@ -8,7 +8,8 @@ module sensor_validation
    use input_text, only: quoted_list, group_context, ordinal
    use input_checks, only: given_or, name_detail
    use scene_memory, only: body_count, wall_count, structure_count, inlet_count
-   use scene_defaults, only: default_name, side_name
+   use scene_defaults, only: default_name
+   use grid_group, only: side_name
    implicit none
    private
 

@@ -1,16 +1,20 @@
 !> The `&inlet` group (docs/input.md, docs/theory.md section 3.1): an opening through which fluid enters.
 !> Here: the type and defaults of its variables (inlet_spec_t), the reader's rows (inlet_variables), the
 !> namelist read, the scene.nml text (inlet_value) and the opening's geometry every user of an inlet
-!> reads (opening_tangent, opening_far_end, has_velocity_file). Its checks name its material and the grid
-!> and stay with the scene's validation (boundary_validation).
+!> reads (opening_tangent, opening_far_end, has_velocity_file), and its checks (validate_inlet: its
+!> material by name, its opening inside the scene box).
 module inlet_group
    use kinds, only: rp, name_len, path_len
-   use input_text, only: int_text, real_text, real_list_text, quoted, logical_text
+   use input_text, only: int_text, real_text, real_list_text, quoted, logical_text, group_context
    use scene_variables, only: variable_info_t, text_len, take_text
+   use error_status, only: status_t
+   use input_checks, only: check_real, check_name, inside_tolerance, axis_letter
+   use grid_group, only: grid_spec_t
+   use material_group, only: material_spec_t, model_newtonian_fluid, find_material
    implicit none
    private
 
-   public :: read_inlet_group, inlet_value, has_velocity_file, opening_tangent, opening_far_end
+   public :: validate_inlet, read_inlet_group, inlet_value, has_velocity_file, opening_tangent, opening_far_end
 
    !> `&inlet`: an opening through which fluid enters at a constant speed, or at the speed (and height) of
    !> a time table `velocity_file` (a hydrograph; algorithms.md section 4.3).
@@ -162,4 +166,90 @@ contains
       far_end = inlet%point + inlet%height * opening_tangent(inlet)
       if (dim == 3) far_end(3) = far_end(3) + inlet%width
    end function opening_far_end
+
+   subroutine validate_inlet(inlet, i, materials, grid, path, status)
+      type(inlet_spec_t), intent(in) :: inlet
+      integer, intent(in) :: i
+      type(material_spec_t), intent(in) :: materials(:)
+      type(grid_spec_t), intent(in) :: grid
+      character(len=*), intent(in) :: path
+      type(status_t), intent(inout) :: status
+      character(len=:), allocatable :: where
+      real(rp) :: far_end(3), tolerance
+      integer :: k, m, dim
+
+      dim = grid%dim
+      where = group_context(path, 'inlet', i, "material '"//trim(inlet%material)//"'")
+      call check_name(where, 'name', inlet%name, status)
+      if (.not. status%ok) return
+      m = find_material(materials, inlet%material)
+      if (m == 0) then
+         call status%fail(where//': variable material must name a declared &material, got '''//trim(inlet%material)//"'")
+         return
+      else if (materials(m)%model /= model_newtonian_fluid) then
+         call status%fail(where//": variable material must name a '"//model_newtonian_fluid//"' material, got '"// &
+                          trim(inlet%material)//"' (model '"//trim(materials(m)%model)//"')")
+         return
+      end if
+      do k = 1, dim
+         call check_real(where, 'point('//int_text(k)//')', inlet%point(k), status)
+         call check_real(where, 'direction('//int_text(k)//')', inlet%direction(k), status)
+      end do
+      call check_real(where, 'height', inlet%height, status, greater_than=0.0_rp)
+      if (dim == 3) call check_real(where, 'width', inlet%width, status, greater_than=0.0_rp)
+      if (has_velocity_file(inlet)) then
+         ! velocity = 0 is the default: a scene record writes it beside the file
+         if (abs(inlet%velocity) > 0.0_rp) then
+            call status%fail(where//': variables velocity and velocity_file exclude each other: give a constant '// &
+                             'speed or a time table of it, not both')
+            return
+         end if
+      else
+         if (len_trim(inlet%velocity_checksum) > 0) then
+            call status%fail(where//': variable velocity_checksum belongs to velocity_file, which is not given')
+            return
+         else if (inlet%height_from_file) then
+            call status%fail(where//': variable height_from_file needs velocity_file (a time table with a column '// &
+                             'height)')
+            return
+         else if (abs(inlet%velocity) == 0.0_rp) then
+            call status%fail(where//': give variable velocity (a constant inflow speed > 0) or velocity_file (a '// &
+                             'time table of t and velocity)')
+            return
+         end if
+         call check_real(where, 'velocity', inlet%velocity, status, greater_than=0.0_rp)
+      end if
+      call check_real(where, 'start_time', inlet%start_time, status, at_least=0.0_rp)
+      call check_real(where, 'end_time', inlet%end_time, status, greater_than=inlet%start_time)
+      if (.not. status%ok) return
+      if (inlet%particles_per_cell < 1) then
+         call status%fail(where//': variable particles_per_cell must be >= 1, got '//int_text(inlet%particles_per_cell))
+         return
+      end if
+      if (norm2(inlet%direction(1:dim)) < tiny(1.0_rp)**0.25_rp) then
+         call status%fail(where//': variable direction must not be zero: it is the direction of the inflow')
+         return
+      end if
+      if (dim == 3 .and. abs(inlet%direction(3)) > 0.0_rp) then
+         call status%fail(where//': variable direction(3) must be 0 (the opening spans height in the x-y plane and '// &
+                          'width along z), got '//real_text(inlet%direction(3)))
+         return
+      end if
+      ! both ends of the opening must lie in the scene box
+      far_end = opening_far_end(inlet, dim)
+      tolerance = inside_tolerance * grid%cell_size
+      do k = 1, dim
+         if (inlet%point(k) < grid%origin(k) - tolerance .or. &
+             inlet%point(k) > grid%origin(k) + grid%extent(k) + tolerance) then
+            call status%fail(where//': variable point('//int_text(k)//') must lie in the scene box of &grid, '// &
+                             real_text(grid%origin(k))//' .. '//real_text(grid%origin(k) + grid%extent(k))//', got '// &
+                             real_text(inlet%point(k)))
+         else if (far_end(k) < grid%origin(k) - tolerance .or. &
+                  far_end(k) > grid%origin(k) + grid%extent(k) + tolerance) then
+            call status%fail(where//': variables point, direction, height and width put the far end of the opening '// &
+                             'outside the scene box of &grid ('//axis_letter(k)//' = '//real_text(far_end(k))//')')
+         end if
+         if (.not. status%ok) return
+      end do
+   end subroutine validate_inlet
 end module inlet_group

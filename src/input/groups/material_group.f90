@@ -1,16 +1,21 @@
 !> The `&material` group (docs/input.md): a constitutive model and its parameters, its stabilization and
 !> volume correction. Here: the type and defaults of its variables (material_spec_t), the model keywords,
 !> the reader's rows (material_variables), the namelist read, the scene.nml text (material_value) and
-!> what its volume correction selects (shifts_particles, relaxes_to_eos). Its checks (ranges, keyword
-!> lists, the combinations with the grid's shape function) stay with the scene's validation.
+!> what its volume correction selects (shifts_particles, relaxes_to_eos), its look-up by name
+!> (find_material) and its checks (validate_material; check_shape_function_combination with &grid).
 module material_group
    use kinds, only: rp, name_len
-   use input_text, only: real_text, quoted, logical_text, canonical_keyword
+   use input_text, only: real_text, quoted, logical_text, canonical_keyword, quoted_list, group_context, ordinal
    use scene_variables, only: variable_info_t, text_len, take_text
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use error_status, only: status_t
+   use input_checks, only: check_real
+   use grid_group, only: grid_spec_t
    implicit none
    private
 
-   public :: read_material_group, material_value, shifts_particles, relaxes_to_eos
+   public :: validate_material, check_shape_function_combination, find_material, read_material_group, &
+             material_value, shifts_particles, relaxes_to_eos
 
    !> Accepted `&material stabilization=` keywords in their canonical spelling (compared without case).
    character(len=*), parameter, public :: stabilization_keywords(*) = [character(len=5) :: 'none', 'C0', 'NB', 'FOAL1']
@@ -25,6 +30,9 @@ module material_group
    character(len=*), parameter, public :: model_linear_elastic = 'linear_elastic'
    character(len=*), parameter, public :: model_rigid = 'rigid'   ! moves as one rigid body per &body
 
+   !> Accepted `&material model=` keywords (stored lower case).
+   character(len=*), parameter, public :: model_keywords(*) = &
+      [character(len=15) :: model_newtonian_fluid, model_linear_elastic, model_rigid]
    !> `&material`: one constitutive model and its parameters.
    type, public :: material_spec_t
       character(len=name_len) :: name = ''
@@ -66,6 +74,9 @@ module material_group
       variable_info_t('material', 'shifting_coefficient', 'real', .false.), &
       variable_info_t('material', 'eos_relaxation_rate', 'real', .false.)]
 
+   !> Above this shifting coefficient the explicit occupancy diffusion is no longer stable (2-D bilinear
+   !> grid Laplacian, docs/volume-conservation.md).
+   real(rp), parameter :: max_shifting_coefficient = 0.25_rp
 contains
 
    !> Read one `&material ... /` (text) over `spec`'s values (scene_reader's read_group).
@@ -174,4 +185,109 @@ contains
       type(material_spec_t), intent(in) :: material
       relaxes_to_eos = index(material%volume_correction, 'eos_relaxation') > 0
    end function relaxes_to_eos
+
+   subroutine validate_material(materials, m, path, status)
+      type(material_spec_t), intent(in) :: materials(:)
+      integer, intent(in) :: m
+      character(len=*), intent(in) :: path
+      type(status_t), intent(inout) :: status
+      character(len=:), allocatable :: where
+      integer :: other
+      logical :: incompressible
+
+      associate (material => materials(m))
+         if (len_trim(material%name) == 0) then
+            call status%fail(group_context(path, 'material', m)//': variable name is required')
+            return
+         end if
+         where = group_context(path, 'material', m, "name '"//trim(material%name)//"'")
+         other = find_material(materials(1:m - 1), material%name)
+         if (other > 0) then
+            call status%fail(where//": variable name '"//trim(material%name)//"' is already used by the "// &
+                             ordinal(other)//' &material')
+            return
+         end if
+         if (all(material%model /= model_keywords)) then
+            call status%fail(where//': variable model must be one of '//quoted_list(model_keywords)//", got '"// &
+                             trim(material%model)//"'")
+            return
+         end if
+         call check_real(where, 'density', material%density, status, greater_than=0.0_rp)
+         select case (trim(material%model))
+         case (model_newtonian_fluid)
+            call check_real(where, 'bulk_modulus', material%bulk_modulus, status, greater_than=0.0_rp)
+            call check_real(where, 'viscosity', material%viscosity, status, at_least=0.0_rp)
+         case (model_linear_elastic)
+            call check_real(where, 'youngs_modulus', material%youngs_modulus, status, greater_than=0.0_rp)
+            incompressible = .false.
+            if (ieee_is_finite(material%poisson_ratio)) incompressible = material%poisson_ratio >= 0.5_rp
+            if (.not. incompressible) then
+               call check_real(where, 'poisson_ratio', material%poisson_ratio, status, greater_than=-1.0_rp, &
+                               less_than=0.5_rp)
+            else
+               ! nu = 0.5 is incompressible: the bulk modulus E / (3 (1 - 2 nu)) would be infinite.
+               call status%fail(where//': variable poisson_ratio must be < 0.5 (0.5 is incompressible: use a '// &
+                                'smaller ratio or a newtonian_fluid), got '//real_text(material%poisson_ratio))
+            end if
+         end select
+         if (all(material%stabilization /= stabilization_keywords)) then
+            call status%fail(where//': variable stabilization must be one of '//quoted_list(stabilization_keywords)// &
+                             ", got '"//trim(material%stabilization)//"'")
+         else if (material%model == model_rigid .and. material%stabilization /= 'none') then
+            call status%fail(where//": variable stabilization must be 'none' for model '"//model_rigid// &
+                             "' (a rigid body has no strain to filter), got '"//trim(material%stabilization)//"'")
+         end if
+         if (all(material%oscillation_rule /= oscillation_rule_keywords)) then
+            call status%fail(where//': variable oscillation_rule must be one of '// &
+                             quoted_list(oscillation_rule_keywords)//", got '"//trim(material%oscillation_rule)//"'")
+         end if
+         if (all(material%smoothed_variables /= smoothed_variables_keywords)) then
+            call status%fail(where//': variable smoothed_variables must be one of '// &
+                             quoted_list(smoothed_variables_keywords)//", got '"//trim(material%smoothed_variables)//"'")
+         end if
+         call check_real(where, 'gamma_max', material%gamma_max, status, at_least=0.0_rp, at_most=1.0_rp)
+         if (all(material%volume_correction /= volume_correction_keywords)) then
+            call status%fail(where//': variable volume_correction must be one of '// &
+                             quoted_list(volume_correction_keywords)//", got '"//trim(material%volume_correction)//"'")
+         else if (material%volume_correction /= 'none' .and. material%model /= model_newtonian_fluid) then
+            call status%fail(where//": variable volume_correction = '"//trim(material%volume_correction)// &
+                             "' is for fluids (model = '"//model_newtonian_fluid//"'), got model = '"// &
+                             trim(material%model)//"'")
+         end if
+         call check_real(where, 'shifting_coefficient', material%shifting_coefficient, status, greater_than=0.0_rp, &
+                         at_most=max_shifting_coefficient)
+         call check_real(where, 'eos_relaxation_rate', material%eos_relaxation_rate, status, greater_than=0.0_rp, &
+                         at_most=1.0_rp)
+      end associate
+   end subroutine validate_material
+
+   !> The schemes of a material that a shape function does not combine with (docs/theory.md section 1.1):
+   !> the volume correction's occupancy and open volumes integrate the multilinear hat of a node over its
+   !> two cells, which bspline2 replaces by a wider support [R].
+   subroutine check_shape_function_combination(material, m, grid, path, status)
+      type(material_spec_t), intent(in) :: material
+      integer, intent(in) :: m
+      type(grid_spec_t), intent(in) :: grid
+      character(len=*), intent(in) :: path
+      type(status_t), intent(inout) :: status
+      if (grid%shape_function == 'linear') return
+      if (material%volume_correction /= 'none') &
+         call status%fail(group_context(path, 'material', m, "name '"//trim(material%name)//"'")// &
+                          ": variable volume_correction = '"//trim(material%volume_correction)// &
+                          "' needs &grid shape_function = 'linear', got '"//trim(grid%shape_function)//"'")
+   end subroutine check_shape_function_combination
+
+   !> Index of the material called `name` (exact match); 0 if there is none.
+   pure integer function find_material(materials, name) result(found)
+      type(material_spec_t), intent(in) :: materials(:)
+      character(len=*), intent(in) :: name
+      integer :: m
+      found = 0
+      do m = 1, size(materials)
+         if (materials(m)%name == name) then
+            found = m
+            return
+         end if
+      end do
+   end function find_material
 end module material_group

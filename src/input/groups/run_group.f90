@@ -1,16 +1,18 @@
 !> The `&run` group (docs/input.md): the time stepping, output, checkpoints and health limits of a run.
 !> Here: the type and defaults of its variables (run_control_t), the particle datasets it may name, the
 !> reader's rows (run_variables), the namelist read, the scene.nml text (run_value) and which particle
-!> datasets a run writes (writes_particle_field). Its checks stay with the scene's validation.
+!> datasets a run writes (writes_particle_field), and the checks of its values (validate_run).
 module run_group
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use kinds, only: rp, i8, name_len, path_len
-   use input_text, only: lower_case, int_text, real_text, quoted, logical_text
+   use input_text, only: lower_case, int_text, real_text, quoted, logical_text, quoted_list, group_context
    use scene_variables, only: variable_info_t, text_len, take_text
+   use error_status, only: status_t
+   use input_checks, only: check_real
    implicit none
    private
 
-   public :: read_run_group, run_value, writes_particle_field
+   public :: validate_run, read_run_group, run_value, writes_particle_field
 
    !> The particle datasets `&run particle_fields` may name (position and connectivity are always written).
    character(len=*), parameter, public :: particle_field_names(*) = [character(len=11) :: 'velocity', 'mass', &
@@ -18,6 +20,10 @@ module run_group
    !> `&run field_precision` keywords.
    character(len=*), parameter, public :: field_precision_keywords(*) = [character(len=6) :: 'double', 'single']
 
+   !> Accepted `&run update_scheme=` keywords (stored upper case).
+   character(len=*), parameter, public :: update_scheme_keywords(*) = [character(len=4) :: 'USL', 'MUSL']
+   !> Accepted `&run transfer=` keywords (stored lower case).
+   character(len=*), parameter, public :: transfer_keywords(*) = [character(len=8) :: 'flip_pic', 'apic']
    !> `&run`: time stepping, update scheme and output control.
    type, public :: run_control_t
       real(rp) :: end_time = -1.0_rp          !< simulated time to reach [s] (required)
@@ -252,4 +258,92 @@ contains
       end do
    end function without_blanks
 
+   subroutine validate_run(run, path, status)
+      type(run_control_t), intent(in) :: run
+      character(len=*), intent(in) :: path
+      type(status_t), intent(inout) :: status
+      character(len=:), allocatable :: where
+
+      where = group_context(path, 'run', 0)
+      call check_real(where, 'end_time', run%end_time, status, greater_than=0.0_rp)
+      call check_real(where, 'cfl', run%cfl, status, greater_than=0.0_rp, at_most=1.0_rp)
+      call check_real(where, 'dt', run%fixed_dt, status, at_least=0.0_rp)
+      call check_real(where, 'output_interval', run%output_interval, status, at_least=0.0_rp)
+      if (len_trim(run%output_dir) == 0) call status%fail(where//': variable output_dir must not be empty')
+      if (all(run%update_scheme /= update_scheme_keywords)) then
+         call status%fail(where//': variable update_scheme must be one of '//quoted_list(update_scheme_keywords)// &
+                          ", got '"//trim(run%update_scheme)//"'")
+      end if
+      if (all(run%transfer /= transfer_keywords)) then
+         call status%fail(where//': variable transfer must be one of '//quoted_list(transfer_keywords)// &
+                          ", got '"//trim(run%transfer)//"'")
+      else if (run%transfer == 'apic' .and. run%flip_fraction_given) then
+         ! a blend the user asked for must not be dropped without a word
+         call status%fail(where//": variable flip_fraction has no effect with transfer = 'apic' (APIC has no FLIP/PIC "// &
+                          "blend); remove it")
+      end if
+      call check_real(where, 'flip_fraction', run%flip_fraction, status, at_least=0.0_rp, at_most=1.0_rp)
+      call check_real(where, 'theta', run%theta, status, greater_than=0.0_rp, at_most=1.0_rp)
+      if (run%max_steps <= 0_i8) then
+         call status%fail(where//': variable max_steps must be > 0, got '//int_text(run%max_steps))
+      end if
+      call check_real(where, 'progress_interval', run%progress_interval, status)
+      call check_real(where, 'floor_size', run%floor_size, status, at_least=0.0_rp)
+      if (run%checkpoint_interval_steps < 0_i8) then
+         call status%fail(where//': variable checkpoint_interval_steps must be >= 0, got '// &
+                          int_text(run%checkpoint_interval_steps))
+      end if
+      call check_real(where, 'checkpoint_interval_wall', run%checkpoint_interval_wall, status, at_least=0.0_rp)
+      if (run%checkpoints_kept < 1) then
+         call status%fail(where//': variable checkpoints_kept must be >= 1, got '//int_text(run%checkpoints_kept))
+      end if
+      call check_real(where, 'speed_limit', run%speed_limit, status, at_least=0.0_rp)
+      ! below 1 even a perfect balance would exceed the threshold (NaN fails the finiteness test first)
+      if (.not. ieee_is_finite(run%rebalance_threshold)) then
+         call check_real(where, 'rebalance_threshold', run%rebalance_threshold, status)
+      else if (run%rebalance_threshold < 0.0_rp .or. &
+               (run%rebalance_threshold > 0.0_rp .and. run%rebalance_threshold < 1.0_rp)) then
+         call status%fail(where//': variable rebalance_threshold must be 0 (off) or >= 1, got '// &
+                          real_text(run%rebalance_threshold))
+      end if
+      if (run%rebalance_interval < 1) then
+         call status%fail(where//': variable rebalance_interval must be >= 1, got '//int_text(run%rebalance_interval))
+      end if
+      call check_real(where, 'load_interval', run%load_interval, status, at_least=0.0_rp)
+      if (status%ok .and. all(run%field_precision /= field_precision_keywords)) then
+         call status%fail(where//': variable field_precision must be one of '//quoted_list(field_precision_keywords)// &
+                          ", got '"//trim(run%field_precision)//"'")
+      end if
+      if (status%ok) call check_particle_fields(where, run%particle_fields, status)
+   end subroutine validate_run
+
+   !> `&run particle_fields` is a comma-separated list of particle datasets (or 'all'; 'position' is
+   !> always written and may be named).
+   subroutine check_particle_fields(where, fields, status)
+      character(len=*), intent(in) :: where, fields
+      type(status_t), intent(inout) :: status
+      character(len=:), allocatable :: item
+      integer :: start, comma
+      start = 1
+      do
+         comma = index(fields(start:), ',')
+         if (comma == 0) then
+            item = trim(fields(start:))
+         else
+            item = fields(start:start + comma - 2)
+         end if
+         if (item /= 'all' .and. item /= 'position' .and. all(particle_field_names /= item)) then
+            if (len(item) == 0) then
+               call status%fail(where//": variable particle_fields has an empty name in '"//trim(fields)// &
+                                "' (a comma-separated list of "//quoted_list(particle_field_names)//", or 'all')")
+            else
+               call status%fail(where//": variable particle_fields: unknown field '"//item//"' (fields: "// &
+                                quoted_list(particle_field_names)//", or 'all'; position is always written)")
+            end if
+            return
+         end if
+         if (comma == 0) return
+         start = start + comma
+      end do
+   end subroutine check_particle_fields
 end module run_group
