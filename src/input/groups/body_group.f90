@@ -7,7 +7,7 @@ module body_group
    use shape_geometry, only: shape_t, max_vertices
    use input_text, only: int_text, real_text, real_list_text, quoted, logical_text
    use scene_variables, only: variable_info_t, text_len, take_text
-   use shape_input, only: shape_to_locals, locals_to_shape, vertex_list
+   use shape_input, only: shape_to_locals, locals_to_shape, shape_value
    implicit none
    private
 
@@ -118,30 +118,10 @@ contains
          text = quoted(body%name)
       case ('material')
          text = quoted(body%material)
-      case ('shape')
-         text = quoted(body%shape%kind)
       case ('lower')
          text = real_list_text(body%lower)
       case ('upper')
          text = real_list_text(body%upper)
-      case ('centre')
-         text = real_list_text(body%shape%centre)
-      case ('size')
-         text = real_list_text(body%shape%size)
-      case ('rotation')
-         text = real_text(body%shape%rotation)
-      case ('rotation_axis')
-         text = real_list_text(body%shape%rotation_axis)
-      case ('radius')
-         text = real_text(body%shape%radius)
-      case ('axis')
-         text = real_list_text(body%shape%axis)
-      case ('length')
-         text = real_text(body%shape%length)
-      case ('vertices')
-         text = vertex_list(body%shape%vertices)
-      case ('z_range')
-         text = real_list_text(body%shape%z_range)
       case ('points_file')
          text = quoted(body%points_file)
       case ('points_checksum')
@@ -157,7 +137,7 @@ contains
       case ('free_surface_level')
          text = real_text(body%free_surface_level)
       case default
-         text = ''
+         text = shape_value(body%shape, name)
       end select
    end function body_value
 end module body_group

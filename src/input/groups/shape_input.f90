@@ -4,11 +4,11 @@ module shape_input
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use kinds, only: rp
    use shape_geometry, only: shape_t, no_vertex, max_vertices
-   use input_text, only: real_list_text
+   use input_text, only: real_text, real_list_text, quoted
    implicit none
    private
 
-   public :: shape_to_locals, locals_to_shape, vertex_given, vertex_list
+   public :: shape_to_locals, locals_to_shape, vertex_given, vertex_list, shape_value
 
 contains
 
@@ -72,4 +72,36 @@ contains
          text = real_list_text(flat(1:n))
       end if
    end function vertex_list
+
+   !> The value of shape variable `name` (shape, centre, size, rotation, rotation_axis, radius, axis, length,
+   !> vertices, z_range) as scene.nml writes it; '' for another name.
+   function shape_value(shape, name) result(text)
+      type(shape_t), intent(in) :: shape
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: text
+      select case (name)
+      case ('shape')
+         text = quoted(shape%kind)
+      case ('centre')
+         text = real_list_text(shape%centre)
+      case ('size')
+         text = real_list_text(shape%size)
+      case ('rotation')
+         text = real_text(shape%rotation)
+      case ('rotation_axis')
+         text = real_list_text(shape%rotation_axis)
+      case ('radius')
+         text = real_text(shape%radius)
+      case ('axis')
+         text = real_list_text(shape%axis)
+      case ('length')
+         text = real_text(shape%length)
+      case ('vertices')
+         text = vertex_list(shape%vertices)
+      case ('z_range')
+         text = real_list_text(shape%z_range)
+      case default
+         text = ''
+      end select
+   end function shape_value
 end module shape_input

@@ -10,7 +10,7 @@ module structure_group
    use scene_variables, only: variable_info_t, text_len, take_text
    use grid_group, only: wall_slip
    use motion_spec, only: motion_spec_t, motion_to_locals, take_motion, motion_value
-   use shape_input, only: shape_to_locals, locals_to_shape, vertex_list
+   use shape_input, only: shape_value, shape_to_locals, locals_to_shape
    implicit none
    private
 
@@ -106,44 +106,24 @@ contains
       type(structure_spec_t), intent(in) :: structure
       character(len=*), intent(in) :: name
       character(len=:), allocatable :: text
-      associate (shape => structure%shape)
-         select case (name)
-         case ('name')
-            text = quoted(structure%name)
-         case ('shape')
-            text = quoted(shape%kind)
-         case ('centre')
-            text = real_list_text(shape%centre)
-         case ('size')
-            text = real_list_text(shape%size)
-         case ('rotation')
-            text = real_text(shape%rotation)
-         case ('rotation_axis')
-            text = real_list_text(shape%rotation_axis)
-         case ('radius')
-            text = real_text(shape%radius)
-         case ('axis')
-            text = real_list_text(shape%axis)
-         case ('length')
-            text = real_text(shape%length)
-         case ('vertices')
-            text = vertex_list(shape%vertices)
-         case ('z_range')
-            text = real_list_text(shape%z_range)
-         case ('lower')
-            text = real_list_text(structure%lower)
-         case ('upper')
-            text = real_list_text(structure%upper)
-         case ('condition')
-            text = quoted(structure%condition)
-         case ('friction')
-            text = real_text(structure%friction)
-         case ('moment_point')
-            text = real_list_text(structure%moment_point)
-         case default
-            text = motion_value(structure%motion, name)
-         end select
-      end associate
+      select case (name)
+      case ('name')
+         text = quoted(structure%name)
+      case ('lower')
+         text = real_list_text(structure%lower)
+      case ('upper')
+         text = real_list_text(structure%upper)
+      case ('condition')
+         text = quoted(structure%condition)
+      case ('friction')
+         text = real_text(structure%friction)
+      case ('moment_point')
+         text = real_list_text(structure%moment_point)
+      case default
+         ! the shape's variables, else the motion's
+         text = shape_value(structure%shape, name)
+         if (len(text) == 0) text = motion_value(structure%motion, name)
+      end select
    end function structure_value
 
    !> The shape of a `&structure` (validated) in a `dim`-D scene: a box given by its corners lower..upper
