@@ -32,7 +32,7 @@ contains
       type(constraint_list_t), intent(out) :: list
       type(load_entry_t), allocatable :: entries(:)
       entries = scene_load_entries(scene)
-      allocate (list%items(0), list%structure(0), list%loads(0), list%active(0), list%blocks_flow(0), list%feeder(0))
+      allocate (list%items(0), list%structure(0), list%loads(0), list%blocks_flow(0), list%feeder(0))
       call add_walls()
       call add_inlets()
       call add_structures()

@@ -14,15 +14,16 @@ module constraint_list
 
    type, public :: constraint_list_t
       type(constraint_slot_t), allocatable :: items(:)
-      !> per constraint: its &structure's number (0: not one), its loads.csv entry (0: none), whether it
-      !> acts now (set_activity) and whether it closes the fluid's space (its condition's traits)
+      !> per constraint: its &structure's number (0: not one), its loads.csv entry (0: none) and whether it
+      !> closes the fluid's space (its condition's traits); whether it acts now: activity()
       integer, allocatable :: structure(:), loads(:)
-      logical, allocatable :: active(:), blocks_flow(:)
+      logical, allocatable :: blocks_flow(:)
       integer, allocatable :: feeder(:)      !< per &inlet: the constraint that is its feeder
    contains
       procedure :: count => list_count
       procedure :: append
       procedure :: set_activity => list_set_activity
+      procedure :: activity => list_activity
       procedure :: constrain => list_constrain
       procedure :: keep_particles_inside
       procedure :: move => list_move
@@ -55,10 +56,9 @@ contains
       end do
       allocate (grown(n + 1)%item, source=item)
       call move_alloc(grown, self%items)
-      if (.not. allocated(self%structure)) allocate (self%structure(0), self%loads(0), self%active(0), self%blocks_flow(0))
+      if (.not. allocated(self%structure)) allocate (self%structure(0), self%loads(0), self%blocks_flow(0))
       self%structure = [self%structure, structure]
       self%loads = [self%loads, item%load]
-      self%active = [self%active, item%active]
       self%blocks_flow = [self%blocks_flow, item%traits%blocks_flow]
       if (present(place)) place = n + 1
    end subroutine append
@@ -76,9 +76,18 @@ contains
       integer :: w
       do w = 1, self%count()
          call self%items(w)%item%set_activity(time)
-         self%active(w) = self%items(w)%item%active
       end do
    end subroutine list_set_activity
+
+   !> Per constraint: it acts now (its activity window holds the time of the last set_activity).
+   pure function list_activity(self) result(active)
+      class(constraint_list_t), intent(in) :: self
+      logical :: active(self%count())
+      integer :: w
+      do w = 1, self%count()
+         active(w) = self%items(w)%item%active
+      end do
+   end function list_activity
 
    !> Constrain nodal velocities, each active constraint in turn (constraint_t%constrain_nodes). With
    !> `mass` and `impulse`, impulse(:, w) gains what constraint w gives the counted nodes. `friction`
@@ -130,7 +139,7 @@ contains
       logical, intent(in), optional :: skip(:)
       type(safeguard_pass_t) :: pass
       integer :: w, d
-      if (.not. any(self%active)) return
+      if (.not. any(self%activity())) return
       d = size(lowest)
       pass%lowest(1:d) = lowest(1:d)
       pass%highest(1:d) = highest(1:d)

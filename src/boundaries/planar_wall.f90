@@ -92,7 +92,7 @@ contains
       type(grid_t), intent(in) :: grid
       real(rp), intent(in) :: x(:), tolerance
       real(rp), intent(in), optional :: widen
-      real(rp) :: distance, foot(size(x)), extra
+      real(rp) :: distance, extra
       integer :: d
       d = size(x)
       extra = 0.0_rp
@@ -100,9 +100,7 @@ contains
       distance = plane_distance(self, grid, x)
       behind = distance <= tolerance .and. distance >= -(self%depth + extra)
       if (.not. behind) return
-      foot = grid%frame%world_point(x - distance * self%normal(1:d))
-      behind = all(foot >= self%lower(1:d) - (self%margin + extra)) .and. &
-               all(foot <= self%upper(1:d) + (self%margin + extra))
+      behind = foot_in_extent(self, grid%frame%world_point(x - distance * self%normal(1:d)), self%margin + extra)
    end function behind_plane
 
    !> True if the foot of the grid-frame point x on the wall lies in its extent.
@@ -111,11 +109,18 @@ contains
       type(grid_t), intent(in) :: grid
       real(rp), intent(in) :: x(:)
       real(rp) :: foot(size(x))
-      integer :: d
-      d = size(x)
-      foot = grid%frame%world_point(x - plane_distance(self, grid, x) * self%normal(1:d))
-      in_extent = all(foot >= self%lower(1:d) - self%margin) .and. all(foot <= self%upper(1:d) + self%margin)
+      foot = grid%frame%world_point(x - plane_distance(self, grid, x) * self%normal(1:size(x)))
+      in_extent = foot_in_extent(self, foot, self%margin)
    end function in_extent
+
+   !> The world-frame foot point lies in the wall's extent widened by `margin` [m] on every side.
+   pure logical function foot_in_extent(self, foot, margin) result(inside)
+      class(planar_wall_t), intent(in) :: self
+      real(rp), intent(in) :: foot(:), margin
+      integer :: d
+      d = size(foot)
+      inside = all(foot >= self%lower(1:d) - margin) .and. all(foot <= self%upper(1:d) + margin)
+   end function foot_in_extent
 
    !> Every point within `reach` of x is in front of the plane.
    logical function plane_clearly_in_front(self, grid, x, reach) result(clear)

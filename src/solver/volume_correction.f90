@@ -215,7 +215,7 @@ contains
       if (.not. self%shifting_now) return
       if (.not. allocated(self%wall_activity)) then
          call measure_open_volumes(self, grid, constraints)
-      else if (any(self%wall_activity .neqv. constraints%active)) then
+      else if (any(self%wall_activity .neqv. constraints%activity())) then
          call measure_open_volumes(self, grid, constraints)
       end if
       call equalize_cell_volumes(self, grid, particles)
@@ -656,7 +656,7 @@ contains
       integer :: horizontal_node(2), second(2)
 
       dim = grid%dim
-      counts = constraints%active .and. constraints%blocks_flow
+      counts = constraints%activity() .and. constraints%blocks_flow
       per_axis = 2 * surface_samples_per_cell(dim)
       sub = grid%h / surface_samples_per_cell(dim)
       sub_volume = sub**dim
@@ -954,8 +954,8 @@ contains
       logical, allocatable :: counts(:), near(:)
 
       dim = grid%dim
-      self%wall_activity = constraints%active
-      counts = constraints%active .and. constraints%blocks_flow
+      self%wall_activity = constraints%activity()
+      counts = constraints%activity() .and. constraints%blocks_flow
       if (allocated(self%open_volume)) deallocate (self%open_volume, self%fully_open)
       allocate (self%open_volume(grid%node_count), self%fully_open(grid%node_count))
       per_axis = 2 * samples_per_cell(dim)

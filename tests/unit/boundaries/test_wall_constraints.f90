@@ -122,7 +122,7 @@ contains
       call walls%append(wall, 0)
       call assertTrue(same_type_as(walls%items(1)%item%condition, free_condition_t()), "'free' makes a free condition")
       call walls%set_activity(0.0_rp)
-      call assertTrue(.not. walls%active(1), 'a free wall is never active')
+      call assertTrue(.not. any(walls%activity()), 'a free wall is never active')
       call assertTrue(.not. walls%blocks_flow(1), 'a free wall lets fluid through')
       v(:, 1) = [1.0_rp, -3.0_rp]
       impulse = 0.0_rp
