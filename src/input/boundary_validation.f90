@@ -1,5 +1,6 @@
-!> Checks of what bounds the material: `&box_walls`, `&wall` (plane, condition, motion), `&structure`
-!> (shape, condition, motion) and `&inlet` (opening, speed or hydrograph, material).
+!> Checks of the walls and structures that read other groups: `&wall` (plane, condition, motion against
+!> the grid and gravity) and `&structure` (shape, condition, motion); `&box_walls` and `&inlet` check
+!> themselves (grid_group, inlet_group).
 module boundary_validation
    use kinds, only: rp
    use error_status, only: status_t

@@ -89,8 +89,7 @@ contains
       end if
       if (allocated(scene%gauges)) then
          do g = 1, size(scene%gauges)
-            call validate_gauge(scene%gauges, g, scene%grid%dim, scene%grid%origin, scene%grid%extent, &
-                                scene%grid%cell_size, path, status)
+            call validate_gauge(scene%gauges, g, scene%grid, path, status)
             if (.not. status%ok) return
          end do
       end if

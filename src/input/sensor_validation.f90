@@ -1,6 +1,6 @@
-!> Checks of what a run measures: `&gauge` groups (kind, point, radius, the wall of a wall_pressure gauge)
-!> and the load namespace (the names of loads.csv: box sides that are walls, &wall, &inlet, &body,
-!> &structure, unique and resolved).
+!> Checks of what a run measures that read other groups: the wall of a wall_pressure gauge (a gauge's own
+!> values: gauge_group) and the load namespace (the names of loads.csv: box sides that are walls, &wall,
+!> &inlet, &body, &structure, unique and resolved).
 module sensor_validation
    use kinds, only: name_len
    use error_status, only: status_t

@@ -72,7 +72,6 @@ contains
          call sum_shared_nodes(state%domain, grid, contact%remapped)
          call state%timers%switch_to(phase_grid_to_particles)
          call contact%remapped_velocities(state%constraints, grid, state%mass_tolerance)
-         call state%timers%switch_to(phase_grid_to_particles)
       end associate
    end subroutine contact_fields_remap
 

@@ -79,7 +79,7 @@ module mpm_solver
    integer, parameter, public :: flag_unhealthy = 1, flag_no_memory = 2
 
    type, public :: solver_t
-      type(scene_t) :: scene                    !< what the walls and inlets are rebuilt from
+      type(scene_t) :: scene                    !< what the constraints are rebuilt from (a new layout)
       type(run_control_t) :: run
       real(rp) :: gravity(3) = 0.0_rp           !< grid frame
       type(domain_t) :: domain
@@ -457,26 +457,23 @@ contains
       integer :: m, first, last, arrived, created
       real(rp) :: dt
       type(stage_context_t) :: context
-      type(step_state_t) :: state
       type(transfer_state_t) :: transfer
       logical :: smoothed(size(self%schemes))
 
       dt = self%dt
-      state = step_state_t(domain=self%domain, grid=self%grid, particles=self%particles, &
-                           constraints=self%constraints, stencils=self%stencils, time=self%time, dt=dt, &
-                           step=self%step)
+      ! the step's state: what the components' stages read (its parent) and what the transfers read
       transfer = transfer_state_t(domain=self%domain, grid=self%grid, particles=self%particles, &
-                                  constraints=self%constraints, stencils=self%stencils, loads=self%loads, &
-                                  rigid=self%rigid, timers=self%timers, gravity=self%gravity, &
-                                  mass_tolerance=self%mass_tolerance, flip_fraction=self%run%flip_fraction, &
-                                  theta=self%run%theta)
+                                  constraints=self%constraints, stencils=self%stencils, time=self%time, dt=dt, &
+                                  step=self%step, loads=self%loads, rigid=self%rigid, timers=self%timers, &
+                                  gravity=self%gravity, mass_tolerance=self%mass_tolerance, &
+                                  flip_fraction=self%run%flip_fraction, theta=self%run%theta)
       call self%timers%switch_to(phase_walls)
       call self%constraints%set_activity(self%time)
-      call run_stage(self, stage_before_walls_move, state)
+      call run_stage(self, stage_before_walls_move, transfer%step_state_t)
       ! moving walls and structures: placed at t_n (node lists rebuilt), their velocity the mean over the step
       call self%constraints%move(self%grid, self%time, self%time + dt)
       call self%loads%begin_step(self%constraints%count())
-      call run_stage(self, stage_walls_placed, state)
+      call run_stage(self, stage_walls_placed, transfer%step_state_t)
       context%domain => self%domain
       context%grid => self%grid
       context%stencils => self%stencils
@@ -495,7 +492,7 @@ contains
       call self%fields%to_grid(transfer)
       call self%timers%switch_to(phase_halo)
       call sum_shared_nodes(self%domain, self%grid, self%grid%accumulated)
-      call run_stage(self, stage_grid_summed, state)
+      call run_stage(self, stage_grid_summed, transfer%step_state_t)
       call self%timers%switch_to(phase_grid_update)
       call self%fields%update_nodes(transfer, dt)
 
@@ -510,7 +507,7 @@ contains
       call self%fields%remap(transfer)
       call move_particles(self, transfer, dt)
       call self%rigid%finish()
-      call run_stage(self, stage_particles_moved, state)
+      call run_stage(self, stage_particles_moved, transfer%step_state_t)
 
       call self%timers%switch_to(phase_stabilization)
       do m = 1, size(self%schemes)
@@ -539,7 +536,7 @@ contains
          call set_slice(m)
          call self%schemes(m)%scheme%filter_stress(context, self%particles)
       end do
-      call run_stage(self, stage_stress_updated, state)
+      call run_stage(self, stage_stress_updated, transfer%step_state_t)
 
       call self%timers%switch_to(phase_walls)
       ! the safeguard against the moving walls and structures where they are at the step's end
@@ -548,7 +545,7 @@ contains
       call self%timers%switch_to(phase_loads)
       call self%loads%end_step(self%constraints%loads)
       created = 0
-      call run_stage(self, stage_end_step, state, created)
+      call run_stage(self, stage_end_step, transfer%step_state_t, created)
       call self%timers%switch_to(phase_migration)
       call migrate_particles(self%domain, self%grid, self%particles, self%lost_particles, arrived)
       call self%timers%switch_to(phase_sort)
@@ -683,10 +680,15 @@ contains
       integer, parameter :: block_size = 256    ! 8 (2-D) to 12 kB (3-D) of rate: stays in L1
       real(rp) :: rate(self%particles%n_sigma, block_size), extent(3, 2)
       real(rp), allocatable :: spin(:, :)
-      integer :: m, first, last, b, e, dim
-      logical :: uses_spin, with_rate
+      integer :: m, first, last, b, e, dim, c
+      logical :: uses_spin, with_rate, shifting
 
       dim = self%grid%dim
+      ! a component that shifts particles this step (the volume correction on its steps): asked once here
+      shifting = .false.
+      do c = 1, size(self%components)
+         if (self%components(c)%component%shifts_now()) shifting = .true.
+      end do
       self%extent(:, 1) = 0.0_rp
       self%extent(:, 2) = 0.0_rp
       self%extent(1:dim, 1) = huge(1.0_rp)
@@ -707,13 +709,13 @@ contains
          if (allocated(self%schemes(m)%scheme)) then
             call particle_kinematics(first, last, self%particles%strain_rate(:, first:last), &
                                      self%particles%spin(:, first:last))
-            call apply_shifts(first, last)
+            if (shifting) call apply_shifts(first, last)
          else
             allocate (spin(merge(n_spin(dim), 0, uses_spin), block_size))
             do b = first, last, block_size
                e = min(last, b + block_size - 1)
                call particle_kinematics(b, e, rate(:, 1:e - b + 1), spin(:, 1:e - b + 1))
-               call apply_shifts(b, e)
+               if (shifting) call apply_shifts(b, e)
                call self%materials(m)%model%update_stress(dim, dt, rate(:, 1:e - b + 1), spin(:, 1:e - b + 1), &
                                                          self%particles%density(b:e), self%particles%sbar(:, b:e))
             end do
@@ -725,7 +727,7 @@ contains
    contains
 
       !> The components' shifts of particles first:last (the volume correction's), each timed as its phase (a
-      !> clock read per call: per material with a scheme, per block without; only on the steps that shift).
+      !> clock read per call: per material with a scheme, per block without; called on the steps that shift).
       subroutine apply_shifts(first, last)
          integer, intent(in) :: first, last
          integer :: c

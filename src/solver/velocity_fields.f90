@@ -6,24 +6,17 @@
 !> field layout; the update scheme (USL, MUSL) is an option of the fields, whose re-map is empty under USL.
 module velocity_fields
    use kinds, only: rp
-   use domain_decomposition, only: domain_t
    use background_grid, only: grid_t
-   use particle_set, only: particle_set_t
-   use constraint_list, only: constraint_list_t
-   use stencil_cache, only: stencil_cache_t
    use wall_loads, only: wall_loads_t
    use rigid_bodies, only: rigid_set_t
    use phase_timers, only: phase_timers_t
+   use step_component, only: step_state_t
    implicit none
    private
 
-   !> What the transfers read and change: the solver's parts (pointers) and its transfer options.
-   type, public :: transfer_state_t
-      type(domain_t), pointer :: domain => null()
-      type(grid_t), pointer :: grid => null()
-      type(particle_set_t), pointer :: particles => null()
-      type(constraint_list_t), pointer :: constraints => null()
-      type(stencil_cache_t), pointer :: stencils => null()    !< the particles' stencils at x^n, P2G to G2P (3-D)
+   !> What the transfers read and change: the step's state (the components' too), the loads, rigid bodies
+   !> and timers, and the transfer options.
+   type, extends(step_state_t), public :: transfer_state_t
       type(wall_loads_t), pointer :: loads => null()          !< the walls' impulse of the step
       type(rigid_set_t), pointer :: rigid => null()           !< the rigid bodies (none: inactive)
       type(phase_timers_t), pointer :: timers => null()

@@ -12,6 +12,7 @@ module gauge_group
    use input_text, only: int_text, real_text, real_list_text, quoted, quoted_list, group_context, ordinal
    use input_checks, only: check_real, check_name, name_detail, inside_tolerance
    use scene_variables, only: variable_info_t, text_len, take_text
+   use grid_group, only: grid_spec_t
    implicit none
    private
 
@@ -96,12 +97,12 @@ contains
       end select
    end function gauge_value
 
-   !> Gauge g of `gauges`: a unique name, a known kind, a finite point inside the scene box (`origin`,
-   !> `extent` of &grid, within 1e-9 of a cell), a radius >= 0.
-   subroutine validate_gauge(gauges, g, dim, origin, extent, cell_size, path, status)
+   !> Gauge g of `gauges`: a unique name, a known kind, a finite point inside the scene box of &grid
+   !> (within 1e-9 of a cell), a radius >= 0.
+   subroutine validate_gauge(gauges, g, grid, path, status)
       type(gauge_spec_t), intent(in) :: gauges(:)
-      integer, intent(in) :: g, dim
-      real(rp), intent(in) :: origin(3), extent(3), cell_size
+      integer, intent(in) :: g
+      type(grid_spec_t), intent(in) :: grid
       character(len=*), intent(in) :: path
       type(status_t), intent(inout) :: status
       character(len=:), allocatable :: where
@@ -129,17 +130,18 @@ contains
                              trim(gauge%kind)//"'")
             return
          end if
-         do k = 1, dim
+         do k = 1, grid%dim
             call check_real(where, 'point('//int_text(k)//')', gauge%point(k), status)
          end do
          call check_real(where, 'radius', gauge%radius, status, at_least=0.0_rp)
          if (.not. status%ok) return
          ! the scene box is axis-aligned in the world frame, whatever the grid's rotation (as for &inlet)
-         tolerance = inside_tolerance * cell_size
-         do k = 1, dim
-            if (gauge%point(k) < origin(k) - tolerance .or. gauge%point(k) > origin(k) + extent(k) + tolerance) then
+         tolerance = inside_tolerance * grid%cell_size
+         do k = 1, grid%dim
+            if (gauge%point(k) < grid%origin(k) - tolerance .or. &
+                gauge%point(k) > grid%origin(k) + grid%extent(k) + tolerance) then
                call status%fail(where//': variable point('//int_text(k)//') must lie in the scene box of &grid, '// &
-                                real_text(origin(k))//' .. '//real_text(origin(k) + extent(k))// &
+                                real_text(grid%origin(k))//' .. '//real_text(grid%origin(k) + grid%extent(k))// &
                                 ', got '//real_text(gauge%point(k)))
                return
             end if
