@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Plot the load series of a Flotsam run: wall loads, gauge readings and solid-body motion.
 
-usage: scripts/plot_loads.py <output folder> [--out DIR] [--show-walls name,...]
+usage: scripts/plot_loads.py <output folder> [--out DIR] [--show-walls name,...] [--cutoff HZ]
 
 Reads whichever of loads.csv, gauges.csv and bodies.csv the run wrote (a file exists only if the scene
 has walls, gauges or solid bodies; docs/output.md) and writes, into the output folder or DIR:
@@ -14,12 +14,16 @@ has walls, gauges or solid bodies; docs/output.md) and writes, into the output f
               force on it.
 
 --show-walls name,...  draw only these walls (drawn even if their load is zero throughout).
+--cutoff HZ            the forces and pressures are drawn as the rows (thin) and low-passed as a sensor
+                       of that bandwidth sees them (bold; zero-phase, default 200 Hz: docs/loads.md,
+                       scripts/load_report.py); 0: the rows only.
 
 The units in the axis labels are those of the files' '# units:' comment line (2-D runs: per metre of
 depth, N/m; 3-D: N). Prints the paths of the pictures written, and the peak values. Exit status 2 if
 the folder holds none of the three files (or a wall of --show-walls does not exist).
 
-Needs matplotlib and numpy (Debian: python3-matplotlib). If the python3 first on PATH lacks them (a
+Needs matplotlib and numpy (Debian: python3-matplotlib), and scipy for the filtered series (python3-scipy;
+without it the rows alone are drawn, and said). If the python3 first on PATH lacks them (a
 pyenv or venv one), the script runs itself again with Debian's /usr/bin/python3. The files are plain CSV with '#' comment lines after the header row, so
 pandas.read_csv(path, comment='#') reads them as well.
 """
@@ -30,6 +34,8 @@ import re
 import sys
 
 FILES = ("loads", "gauges", "bodies")
+#: the low-pass of the bold series (set from --cutoff in main; 0: none)
+CUTOFF_HZ = [0.0]
 # Line styles tell the components of one wall / body apart; colours tell the walls apart.
 COMPONENT_STYLES = {"x": "-", "y": "--", "z": "-."}
 
@@ -60,7 +66,7 @@ class Series:
                 raise ValueError(f"{path}: row {number + 1} has {len(row)} values for {len(self.names)} columns")
         data = np.array(rows, dtype=float).reshape(len(rows), len(self.names))
         self.columns = {name: data[:, k] for k, name in enumerate(self.names)}
-        self.units = parse_units(self.comments)
+        self.units = signals_module(filtering=False).parse_units(self.comments)
         self.per_depth = any("per metre of depth" in comment for comment in self.comments)
 
     def __len__(self):
@@ -81,24 +87,6 @@ class Series:
             if match:
                 return match.group(1).strip()
         return ""
-
-
-def parse_units(comments):
-    """{'time': 's', '_fx': 'N/m', '_mz': 'N m/m', ...} from a line such as
-    '# units: time s; _fx _fy _fz N/m; _mx _my _mz N m/m (2-D plane strain: per metre of depth)'."""
-    units = {}
-    for comment in comments:
-        if not comment.lower().startswith("units:"):
-            continue
-        for part in comment.split(":", 1)[1].split(";"):
-            part = re.sub(r"\(.*\)", "", part).strip()   # explanations in parentheses
-            words = part.split()
-            keys = []
-            while words and (words[0].startswith("_") or words[0] == "time"):
-                keys.append(words.pop(0))
-            for key in keys:
-                units[key] = " ".join(words)
-    return units
 
 
 def prefixed(values, unit):
@@ -139,6 +127,49 @@ def peak(times, values):
     return float(times[k]), float(values[k])
 
 
+def signals_module(filtering=True):
+    """scripts/load_signals.py (beside this script, or in <prefix>/share/flotsam/python when installed).
+    With `filtering`: None if scipy is missing (the rows are then drawn alone)."""
+    here = os.path.dirname(os.path.realpath(__file__))
+    for folder in (here, os.path.join(here, os.pardir, "share", "flotsam", "python")):
+        if os.path.isfile(os.path.join(folder, "load_signals.py")):
+            if os.path.abspath(folder) not in sys.path:
+                sys.path.insert(0, os.path.abspath(folder))
+            break
+    else:
+        fail("cannot find load_signals.py beside the script or in <prefix>/share/flotsam/python")
+    import load_signals
+    if filtering:
+        try:
+            import scipy.signal  # noqa: F401
+        except ImportError:
+            return None
+    return load_signals
+
+
+def draw(axis, times, values, style, colour, name, means=True):
+    """A series as its rows (thin) and, with a cutoff, low-passed (bold, labelled); the rows alone (labelled)
+    otherwise. `means`: the rows are interval means (placed at their intervals' centres when filtered)."""
+    signals = signals_module() if CUTOFF_HZ[0] > 0.0 else None
+    if signals is None:
+        axis.plot(times, values, style, color=colour, linewidth=1.0, label=name)
+        return
+    centres = signals.sample_times(times, means)
+    filtered, _ = signals.low_pass(centres, values, CUTOFF_HZ[0])
+    axis.plot(times, values, style, color=colour, linewidth=0.6, alpha=0.4)
+    axis.plot(centres, filtered, style, color=colour, linewidth=1.4, label=name)
+
+
+def filter_note():
+    """What the bold lines are, for a figure's notes."""
+    if CUTOFF_HZ[0] <= 0.0:
+        return "rows as written"
+    if signals_module() is None:
+        return "rows as written (no scipy: python3-scipy draws them low-passed too)"
+    return (f"thin: the rows; bold: low-passed at {CUTOFF_HZ[0]:g} Hz (zero phase), as a sensor of that bandwidth "
+            "sees them;\nscripts/load_report.py gives their peaks, impulse, rise and decay")
+
+
 # --- loads.png ----------------------------------------------------------------------------------------
 
 def plot_loads(series, out_dir, shown_walls, plt):
@@ -176,8 +207,8 @@ def plot_loads(series, out_dir, shown_walls, plt):
             if shown_walls is None and all_zero(series, [column]):
                 zero_components.append(column)
                 continue
-            force_axis.plot(time, force_scale * series[column], COMPONENT_STYLES[a], color=colours[wall],
-                            linewidth=1.0, label=f"{wall} $F_{a}$")
+            draw(force_axis, time, force_scale * series[column], COMPONENT_STYLES[a], colours[wall],
+                 f"{wall} $F_{a}$")
         for a in moment_axes:
             column = f"{wall}_m{a}"
             if column not in series:
@@ -196,7 +227,7 @@ def plot_loads(series, out_dir, shown_walls, plt):
         axis.grid(True, alpha=0.3)
         if axis.get_legend_handles_labels()[0]:
             axis.legend(fontsize=8, loc="best", ncol=2 if len(drawn) > 3 else 1)
-    notes = ["mean force over each row's interval, exerted by the material on the wall (world frame)"]
+    notes = ["mean force over each row's interval, exerted by the material on the wall (world frame)", filter_note()]
     if skipped:
         notes.append("left out (zero load throughout): " + ", ".join(skipped))
     if zero_components:
@@ -251,7 +282,9 @@ def plot_gauges(series, out_dir, plt):
             values = [series[f"{g}_pressure"] for g in pressure]
             scale, unit = prefixed(np.concatenate(values), series.unit("_pressure", "Pa"))
             for g in pressure:
-                axis.plot(time, scale * series[f"{g}_pressure"], color=colours[g], linewidth=1.0, label=g)
+                # a wall_pressure gauge (no _samples) is an interval mean, a fluid one a sample
+                draw(axis, time, scale * series[f"{g}_pressure"], "-", colours[g], g,
+                     means=f"{g}_samples" not in series)
             axis.set_ylabel(label("pressure", unit))
         elif kind == "level":
             for g in level:
@@ -272,6 +305,9 @@ def plot_gauges(series, out_dir, plt):
         axis.legend(fontsize=8, loc="best")
     axes[-1].set_xlabel(label("time", series.unit("time", "s")))
     axes[0].set_title(scene_title(series, "Gauges (pressure, level: 0 where the gauge sees no fluid; velocity: gap)"), fontsize=10)
+    if pressure:
+        axes[-1].text(0.0, -0.3, "pressure: " + filter_note(), transform=axes[-1].transAxes, fontsize=7.5,
+                      va="top", color="0.3")
     figure.tight_layout()
     path = os.path.join(out_dir, "gauges.png")
     figure.savefig(path, dpi=120)
@@ -389,21 +425,6 @@ def plot_bodies(series, out_dir, plt):
 
 # --- main ---------------------------------------------------------------------------------------------
 
-def use_debian_python():
-    """Re-run with /usr/bin/python3 when this python has no matplotlib and Debian's might."""
-    try:
-        import matplotlib  # noqa: F401
-        import numpy  # noqa: F401
-        return
-    except ImportError as error:
-        debian = "/usr/bin/python3"
-        if os.path.realpath(sys.executable) != os.path.realpath(debian) and os.access(debian, os.X_OK) \
-                and not os.environ.get("FLOTSAM_PLOT_REEXEC"):
-            os.environ["FLOTSAM_PLOT_REEXEC"] = "1"
-            os.execv(debian, [debian, os.path.abspath(__file__)] + sys.argv[1:])
-        fail(f"{error} (install Debian's python3-matplotlib: apt-get install python3-matplotlib)")
-
-
 def fail(message):
     print(f"plot_loads: error: {message}", file=sys.stderr)
     sys.exit(2)
@@ -417,7 +438,12 @@ def main():
     parser.add_argument("--out", metavar="DIR", help="folder for the PNGs (default: the output folder)")
     parser.add_argument("--show-walls", metavar="NAME,...",
                         help="draw only these walls of loads.csv (comma separated)")
+    parser.add_argument("--cutoff", type=float, default=200.0, metavar="HZ",
+                        help="draw forces and pressures also low-passed at this cutoff (default 200; 0: rows only)")
     arguments = parser.parse_args()
+    if arguments.cutoff < 0.0:
+        fail(f"--cutoff must be >= 0 Hz, got {arguments.cutoff:g}")
+    CUTOFF_HZ[0] = arguments.cutoff
 
     folder = arguments.folder
     if not os.path.isdir(folder):
@@ -440,7 +466,8 @@ def main():
     out_dir = arguments.out or folder
     os.makedirs(out_dir, exist_ok=True)
 
-    use_debian_python()
+    signals_module(filtering=False).reexec_with_debian_python(__file__, ("numpy", "matplotlib"),
+                                                              "FLOTSAM_PLOT_REEXEC", fail)
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

@@ -23,7 +23,7 @@ module constraint
    use background_grid, only: grid_t
    use particle_set, only: particle_set_t
    use wall_motion, only: wall_motion_t
-   use wall_pressure_taps, only: pressure_taps_t
+   use surface_sensors, only: sensor_taps_t, add_tap_impulse
    use surface_condition, only: surface_condition_t, condition_traits_t, friction_node
    implicit none
    private
@@ -53,6 +53,8 @@ module constraint
       integer, pointer :: field(:) => null()
       real(rp), pointer :: field_friction(:) => null()
       real(rp), pointer :: field_impulse(:, :) => null()
+      !> the sensors' columns of the impulse accumulator (panels and load cells take the safeguard's part)
+      real(rp), pointer, contiguous :: sensor_impulse(:, :) => null()
    end type safeguard_pass_t
 
    type, abstract, public :: constraint_t
@@ -76,10 +78,10 @@ module constraint
       type(wall_motion_t) :: motion
       real(rp) :: shift(3) = 0.0_rp, nodes_shift(3) = 0.0_rp
       real(rp) :: wall_velocity(3) = 0.0_rp
-      !> wall-pressure sensors on this surface and their taps on its nodes (wall_pressure_taps): a counted
-      !> node's impulse adds dp . vector to the sensor's column of the impulse accumulator, after the
-      !> constraints' columns
-      type(pressure_taps_t) :: taps
+      !> the sensors on this surface (gauges, panels, load cells) and their taps on its nodes
+      !> (surface_sensors): a counted node's impulse adds its share to the sensor's column of the impulse
+      !> accumulator, after the constraints' columns
+      type(sensor_taps_t) :: taps
    contains
       !> signed distance phi of a grid-frame point [m], and (optional) the unit normal (grid frame) there
       procedure(distance_interface), deferred :: distance
@@ -107,6 +109,7 @@ module constraint
       procedure :: node_normal
       procedure :: constrain
       procedure :: record_impulse
+      procedure :: record_particle_impulse
       procedure :: keep_nodes
       procedure :: scan_nodes
    end type constraint_t
@@ -282,19 +285,19 @@ contains
    subroutine place_taps(self, grid)
       class(constraint_t), intent(inout) :: self
       type(grid_t), intent(in) :: grid
-      real(rp), allocatable :: feet(:, :), normals(:, :)
-      real(rp) :: x(grid%dim), phi
+      real(rp), allocatable :: points(:, :), feet(:, :), normals(:, :)
+      real(rp) :: phi
       integer :: i, dim
       if (.not. self%taps%any()) return
       dim = grid%dim
-      allocate (feet(dim, size(self%nodes)), normals(dim, size(self%nodes)))
+      allocate (points(dim, size(self%nodes)), feet(dim, size(self%nodes)), normals(dim, size(self%nodes)))
       do i = 1, size(self%nodes)
-         x = grid%origin(1:dim) + grid%node_indices(self%nodes(i)) * grid%h
+         points(:, i) = grid%origin(1:dim) + grid%node_indices(self%nodes(i)) * grid%h
          normals(:, i) = self%node_normal(i, dim)
-         phi = self%distance(grid, x)
-         feet(:, i) = x - phi * normals(:, i)
+         phi = self%distance(grid, points(:, i))
+         feet(:, i) = points(:, i) - phi * normals(:, i)
       end do
-      call self%taps%place(dim, grid%h, feet, normals)
+      call self%taps%place(dim, grid%h, points, feet, normals, grid%frame)
    end subroutine place_taps
 
    !> The normal it constrains its i-th node along (grid frame).
@@ -360,16 +363,29 @@ contains
       integer, intent(in) :: column, n_columns, i
       real(rp), intent(in) :: dp(:)
       real(rp), intent(inout) :: impulse(:, :)
-      integer :: t, sensor_column
+      integer :: t
       call add_impulse(impulse(:, column), dp, self%arm(1:size(dp), i))
       if (.not. allocated(self%taps%first)) return
       do t = self%taps%first(i), self%taps%first(i + 1) - 1
-         sensor_column = n_columns + self%taps%slot(t)
-         ! a body field's accumulator (body_contact) has the constraints' columns only
-         if (sensor_column > size(impulse, 2)) cycle
-         impulse(1, sensor_column) = impulse(1, sensor_column) + dot_product(dp, self%taps%vector(:, t))
+         call add_tap_impulse(self%taps, t, dp, impulse(:, n_columns + 1:))
       end do
    end subroutine record_impulse
+
+   !> The safeguard's impulse dp on a particle it put back onto the surface at x (grid frame): the load's
+   !> column of the pass (add_impulse, about the moment point) and its panels' and load cells' columns.
+   subroutine record_particle_impulse(self, grid, pass, dp, x)
+      class(constraint_t), intent(in) :: self
+      type(grid_t), intent(in) :: grid
+      type(safeguard_pass_t), intent(inout) :: pass
+      real(rp), intent(in) :: dp(:), x(:)
+      real(rp) :: normal(size(x)), phi
+      integer :: d
+      d = size(dp)
+      call add_impulse(pass%impulse, dp, x - self%moment_point(1:d))
+      if (.not. self%taps%force_sensors .or. .not. associated(pass%sensor_impulse)) return
+      phi = self%distance(grid, x, normal)
+      call self%taps%add_point_impulse(d, grid%h, x, normal, grid%frame, dp, pass%sensor_impulse)
+   end subroutine record_particle_impulse
 
    !> impulse(1:3) += dp, impulse(4:6) += arm x dp (2-D: only the z component of the moment).
    pure subroutine add_impulse(impulse, dp, arm)

@@ -7,7 +7,7 @@ module constraint_list
    use kinds, only: rp
    use background_grid, only: grid_t
    use particle_set, only: particle_set_t
-   use wall_pressure_taps, only: wall_sensor_t, tangent_axes
+   use surface_sensors, only: surface_sensor_t, tangent_axes, patch_weight, sensor_panel, sensor_load_cell
    use constraint, only: constraint_t, constraint_slot_t, safeguard_pass_t
    implicit none
    private
@@ -121,7 +121,8 @@ contains
    !> (all three or none): `field` (particle) the velocity field of each particle (0: the common one),
    !> `field_friction` (constraint, field) the mu a structure applies to that field instead of its condition
    !> (< 0: its condition), and field_impulse(:, w, f) gains the part of impulse(:, w) given to field f's
-   !> particles. The particles of a material with `skip(material)` are left alone: rigid bodies meet the
+   !> particles. Columns of `impulse` after the constraints' are the sensors' (surface_sensors: panels and
+   !> load cells gain their part of the safeguard's impulse). The particles of a material with `skip(material)` are left alone: rigid bodies meet the
    !> walls as bodies (rigid_bodies). lowest(1:dim), highest(1:dim): bounds on the particles' coordinates
    !> (the step's extent, which G2P takes as it moves them; wider is fine). They only let a pass be skipped
    !> when no particle can be behind a constraint; a pass of their own over the particles was 3 % of a 2-D step.
@@ -151,6 +152,8 @@ contains
       end if
       pass%corrections = corrections
       if (present(field)) pass%field => field
+      ! the sensors' columns follow the constraints' (panels and load cells take the safeguard's part)
+      if (size(impulse, 2) > self%count()) pass%sensor_impulse => impulse(:, self%count() + 1:)
       do w = 1, self%count()
          associate (c => self%items(w)%item)
             if (.not. c%active) cycle
@@ -201,23 +204,26 @@ contains
       end do
    end function moving_speed
 
-   !> Put the wall-pressure sensors `sensors` (their slot, point in the world frame, radius) on the
-   !> constraints of the loads.csv entries `entries` (per sensor), with the sensor's point moved onto the
-   !> surface, the surface's normal there and the intervals it can be wetted along grid axes (the scene box,
-   !> cut by the planar walls across them); then their taps. `offset` (per sensor) is how far the given point
-   !> lay from the surface [m] (the caller refuses a point off it).
-   subroutine attach_sensors(self, grid, sensors, entries, offset)
+   !> Put the sensors `sensors` (gauges: their point in the world frame and radius; panels and load cells:
+   !> their box) on the constraints of the loads.csv entries `entries` (per sensor; 0: every constraint, a
+   !> load cell without a wall). A gauge's or panel's centre is moved onto the surface, with the surface's
+   !> normal there and the intervals it can be wetted along grid axes (the scene box, cut by the planar
+   !> walls across them); then their taps. `offset` (per sensor) is how far the given point (a panel: its
+   !> box, along the normal) lay from the surface [m], `outside` the part of a panel's area that lies off
+   !> the wettable surface (the caller refuses a sensor off its surface; both 0 for load cells).
+   subroutine attach_sensors(self, grid, sensors, entries, offset, outside)
       class(constraint_list_t), intent(inout) :: self
       type(grid_t), intent(in) :: grid
-      type(wall_sensor_t), intent(in) :: sensors(:)
+      type(surface_sensor_t), intent(in) :: sensors(:)
       integer, intent(in) :: entries(:)
-      real(rp), intent(out) :: offset(:)
-      type(wall_sensor_t) :: sensor
-      real(rp) :: x(grid%dim), phi, tangents(grid%dim, grid%dim - 1)
+      real(rp), intent(out) :: offset(:), outside(:)
+      type(surface_sensor_t) :: sensor
+      real(rp) :: x(grid%dim), phi, tangents(grid%dim, grid%dim - 1), weight, area, thickness
       logical :: axes
       integer :: s, w, v, k, along, dim
       dim = grid%dim
       offset = huge(1.0_rp)
+      outside = 0.0_rp
       do w = 1, self%count()
          associate (taps => self%items(w)%item%taps)
             if (allocated(taps%sensors)) deallocate (taps%sensors)
@@ -225,14 +231,24 @@ contains
          end associate
       end do
       do s = 1, size(sensors)
+         if (sensors(s)%kind == sensor_load_cell) offset(s) = 0.0_rp
          do w = 1, self%count()
             associate (c => self%items(w)%item)
-               if (c%load /= entries(s)) cycle
+               if (c%load /= entries(s) .and. entries(s) /= 0) cycle
                sensor = sensors(s)
-               x = grid%frame%grid_point(sensors(s)%point(1:dim))
+               if (sensor%kind == sensor_load_cell) then
+                  c%taps%sensors = [c%taps%sensors, sensor]
+                  cycle
+               end if
+               if (sensor%kind == sensor_panel) sensor%point(1:dim) = 0.5_rp * (sensor%lower(1:dim) + sensor%upper(1:dim))
+               x = grid%frame%grid_point(sensor%point(1:dim))
                sensor%normal = 0.0_rp
                phi = c%distance(grid, x, sensor%normal(1:dim))
-               offset(s) = min(offset(s), abs(phi))
+               thickness = 0.0_rp
+               if (sensor%kind == sensor_panel) &
+                  thickness = abs(dot_product(grid%frame%grid_vector(sensor%upper(1:dim) - sensor%lower(1:dim)), &
+                                              sensor%normal(1:dim)))
+               offset(s) = min(offset(s), max(0.0_rp, abs(phi) - 0.5_rp * thickness))
                sensor%point = 0.0_rp
                sensor%point(1:dim) = x - phi * sensor%normal(1:dim)
                call tangent_axes(sensor%normal(1:dim), dim, tangents, axes)
@@ -247,6 +263,11 @@ contains
                                                                     sensor%wet_lo(along), sensor%wet_hi(along))
                      end do
                   end do
+               end if
+               call sensor%set_patch(dim, grid%frame, grid%origin(1:dim), grid%h)
+               if (sensor%kind == sensor_panel) then
+                  call patch_weight(sensor, dim, grid%h, sensor%point(1:dim), weight, area)
+                  outside(s) = 1.0_rp - area / product(sensor%patch_hi(1:dim - 1) - sensor%patch_lo(1:dim - 1))
                end if
                c%taps%sensors = [c%taps%sensors, sensor]
             end associate

@@ -8,7 +8,7 @@ module planar_wall
    use background_grid, only: grid_t
    use particle_set, only: particle_set_t
    use surface_condition, only: surface_condition_t
-   use constraint, only: constraint_t, safeguard_pass_t, add_impulse, constraint_depth
+   use constraint, only: constraint_t, safeguard_pass_t, constraint_depth
    implicit none
    private
 
@@ -217,7 +217,7 @@ contains
       ! any wall; a moving one: a particle behind it gets at least the wall's normal velocity, v - v_w
       ! losing what the condition takes
       vw = self%wall_velocity(1:d)
-      associate (n => self%normal(1:d), x0 => self%point(1:d), impulse => pass%impulse, skip => pass%skip, &
+      associate (n => self%normal(1:d), x0 => self%point(1:d), skip => pass%skip, &
                  corrections => pass%corrections)
          do p = 1, particles%count
             distance = dot_product(particles%x(:, p) - x0, n)
@@ -229,14 +229,14 @@ contains
                before = particles%v(:, p)
                if (dot_product(before - vw, n) < 0.0_rp) then
                   particles%v(:, p) = self%condition%particle_velocity(before, vw, n, .true.)
-                  call add_impulse(impulse, particles%mass(p) * (particles%v(:, p) - before), &
-                                   particles%x(:, p) - self%moment_point(1:d))
+                  call self%record_particle_impulse(grid, pass, particles%mass(p) * (particles%v(:, p) - before), &
+                                                    particles%x(:, p))
                end if
             else
                vn = dot_product(particles%v(:, p), n)
                if (vn < 0.0_rp) then
                   call self%condition%particle_on_plane(particles%v(:, p), n, vn, particles%mass(p), dp)
-                  call add_impulse(impulse, dp, particles%x(:, p) - self%moment_point(1:d))
+                  call self%record_particle_impulse(grid, pass, dp, particles%x(:, p))
                end if
             end if
             corrections = corrections + 1
@@ -252,7 +252,7 @@ contains
          k = self%axis
          sense = self%normal(k)
          x0 = self%point(k)
-         associate (impulse => pass%impulse, skip => pass%skip, corrections => pass%corrections)
+         associate (skip => pass%skip, corrections => pass%corrections)
             do p = 1, particles%count
                if (sense * (particles%x(k, p) - x0) >= 0.0_rp) cycle
                if (skip(particles%material(p))) cycle
@@ -261,7 +261,7 @@ contains
                if (sense * particles%v(k, p) < 0.0_rp) then
                   call self%condition%particle_on_plane(particles%v(:, p), self%normal(1:d), sense * particles%v(k, p), &
                                                         particles%mass(p), dp, axis=k)
-                  call add_impulse(impulse, dp, particles%x(:, p) - self%moment_point(1:d))
+                  call self%record_particle_impulse(grid, pass, dp, particles%x(:, p))
                end if
                corrections = corrections + 1
             end do

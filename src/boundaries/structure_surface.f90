@@ -150,7 +150,7 @@ contains
       step = normal_step_in_cells * grid%h
       tolerance = on_surface_tolerance * grid%h
       vw = self%wall_velocity(1:d)
-      associate (impulse => pass%impulse, skip => pass%skip, corrections => pass%corrections)
+      associate (skip => pass%skip, corrections => pass%corrections)
          do p = 1, particles%count
             if (any(particles%x(:, p) < self%box_lower(1:d)) .or. any(particles%x(:, p) > self%box_upper(1:d))) cycle
             world = grid%frame%world_point(particles%x(:, p))
@@ -174,7 +174,7 @@ contains
                   particles%v(:, p) = self%condition%particle_velocity(before, vw, n, self%moving)
                end if
                dp = particles%mass(p) * (particles%v(:, p) - before)
-               call add_impulse(impulse, dp, particles%x(:, p) - self%moment_point(1:d))
+               call self%record_particle_impulse(grid, pass, dp, particles%x(:, p))
                if (f > 0) call add_impulse(pass%field_impulse(:, f), dp, particles%x(:, p) - self%moment_point(1:d))
             end if
             corrections = corrections + 1

@@ -86,6 +86,7 @@ contains
                                                                                                  scene%grid%dim)
          end associate
       end do
+      if (.not. allocated(scene%panels)) allocate (scene%panels(0))
       if (.not. allocated(scene%gauges)) allocate (scene%gauges(0))
       do g = 1, size(scene%gauges)
          associate (gauge => scene%gauges(g))

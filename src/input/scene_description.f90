@@ -16,6 +16,7 @@ module scene_description
    use inlet_group, only: inlet_spec_t, has_velocity_file, opening_tangent, opening_far_end
    use gauge_group, only: gauge_spec_t, gauge_pressure, gauge_level, gauge_connected_level, gauge_velocity, &
                           gauge_wall_pressure
+   use panel_group, only: panel_spec_t, panel_surface, panel_load_cell
    use contact_group, only: contact_spec_t
    implicit none
    private
@@ -32,6 +33,7 @@ module scene_description
    public :: structure_spec_t, structure_shape
    public :: inlet_spec_t, has_velocity_file, opening_tangent, opening_far_end
    public :: gauge_spec_t, gauge_pressure, gauge_level, gauge_connected_level, gauge_velocity, gauge_wall_pressure
+   public :: panel_spec_t, panel_surface, panel_load_cell
    public :: contact_spec_t
 
    !> The points of a `&body points_file` (empty for the other bodies): world positions and volumes.
@@ -60,6 +62,7 @@ module scene_description
       !> per inlet, the table of its velocity_file (read by rank 0, broadcast with the scene; no rows: none)
       type(time_table_t), allocatable :: inlet_tables(:)
       type(gauge_spec_t), allocatable :: gauges(:)
+      type(panel_spec_t), allocatable :: panels(:)     !< `&panel` groups (panels.csv)
       type(contact_spec_t), allocatable :: contacts(:)
    end type scene_t
 end module scene_description

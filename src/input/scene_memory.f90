@@ -13,7 +13,7 @@ module scene_memory
    private
 
    public :: check_scene_memory, scene_particle_count, memory_estimate_per_rank, scene_advice
-   public :: body_count, wall_count, structure_count, inlet_count
+   public :: body_count, wall_count, structure_count, inlet_count, gauge_count, panel_count
 
    !> Peak resident memory per particle a run grows by [bytes]: particle arrays, sort buffers and the
    !> fields file's buffers, measured as the slope of run_summary.csv's peak_memory_bytes over the
@@ -208,4 +208,16 @@ contains
       inlet_count = 0
       if (allocated(scene%inlets)) inlet_count = size(scene%inlets)
    end function inlet_count
+
+   pure integer function gauge_count(scene)
+      type(scene_t), intent(in) :: scene
+      gauge_count = 0
+      if (allocated(scene%gauges)) gauge_count = size(scene%gauges)
+   end function gauge_count
+
+   pure integer function panel_count(scene)
+      type(scene_t), intent(in) :: scene
+      panel_count = 0
+      if (allocated(scene%panels)) panel_count = size(scene%panels)
+   end function panel_count
 end module scene_memory

@@ -11,7 +11,7 @@ module scene_reader
    use kinds, only: path_len
    use error_status, only: status_t
    use scene_description, only: scene_t, material_spec_t, body_spec_t, wall_spec_t, inlet_spec_t, gauge_spec_t, &
-                                structure_spec_t, contact_spec_t, model_newtonian_fluid, model_linear_elastic, &
+                                panel_spec_t, structure_spec_t, contact_spec_t, model_newtonian_fluid, model_linear_elastic, &
                                 model_rigid
    use shape_geometry, only: max_vertices
    use namelist_scan, only: namelist_file_t, namelist_group_t, scan_namelist_file
@@ -20,6 +20,7 @@ module scene_reader
    use scene_memory, only: check_scene_memory
    use scene_variables, only: variable_info_t, value_too_long
    use gauge_group, only: gauge_variables, read_gauge_group
+   use panel_group, only: panel_variables, read_panel_group
    use body_group, only: body_variables, read_body_group
    use structure_group, only: structure_variables, read_structure_group
    use wall_group, only: wall_variables, read_wall_group
@@ -58,12 +59,12 @@ module scene_reader
    !> The namelist groups of a scene file, in the order a resolved scene is written (scene_record).
    character(len=*), parameter, public :: known_groups(*) = &
       [character(len=9) :: 'run', 'grid', 'box_walls', 'gravity', 'material', 'body', 'wall', 'inlet', 'gauge', &
-                           'structure', 'contact']
+                           'panel', 'structure', 'contact']
    !> Groups that may appear at most once.
    character(len=*), parameter :: singleton_groups(*) = [character(len=9) :: 'run', 'grid', 'box_walls', 'gravity']
    !> Groups that may appear any number of times, one scene entry each.
    character(len=*), parameter, public :: repeated_groups(*) = &
-      [character(len=9) :: 'material', 'body', 'wall', 'inlet', 'gauge', 'structure', 'contact']
+      [character(len=9) :: 'material', 'body', 'wall', 'inlet', 'gauge', 'panel', 'structure', 'contact']
    !> Groups a scene file must contain.
    character(len=*), parameter :: required_groups(*) = [character(len=8) :: 'run', 'grid', 'material']
 
@@ -79,6 +80,7 @@ module scene_reader
       wall_variables, &
       inlet_variables, &
       gauge_variables, &
+      panel_variables, &
       contact_variables, &
       structure_variables]
 
@@ -219,7 +221,7 @@ contains
       if (.not. status%ok) return
       call read_singleton_groups(file, scene, status)
       if (.not. status%ok) return
-      allocate (probe%materials(1), probe%bodies(1), probe%walls(1), probe%inlets(1), probe%gauges(1), &
+      allocate (probe%materials(1), probe%bodies(1), probe%walls(1), probe%inlets(1), probe%gauges(1), probe%panels(1), &
                 probe%structures(1), probe%contacts(1))
       do g = 1, size(file%groups)
          group = file%groups(g)%name
@@ -264,7 +266,7 @@ contains
       character(len=*), intent(in) :: group
       character(len=:), allocatable :: name
       select case (group)
-      case ('material', 'wall', 'gauge', 'structure')
+      case ('material', 'wall', 'gauge', 'panel', 'structure')
          name = 'name'
       case ('body', 'inlet')
          name = 'material'
@@ -295,6 +297,8 @@ contains
          if (len(value) == 0) value = default_name('wall', i)
       case ('gauge')
          value = trim(scene%gauges(i)%name)
+      case ('panel')
+         value = trim(scene%panels(i)%name)
       case ('structure')
          ! an unnamed structure is selected by its default name (structure_<k>)
          value = trim(scene%structures(i)%name)
@@ -322,6 +326,8 @@ contains
          if (allocated(scene%inlets)) n = size(scene%inlets)
       case ('gauge')
          if (allocated(scene%gauges)) n = size(scene%gauges)
+      case ('panel')
+         if (allocated(scene%panels)) n = size(scene%panels)
       case ('contact')
          if (allocated(scene%contacts)) n = size(scene%contacts)
       case ('structure')
@@ -441,6 +447,7 @@ contains
       type(wall_spec_t) :: default_wall
       type(inlet_spec_t) :: default_inlet
       type(gauge_spec_t) :: default_gauge
+      type(panel_spec_t) :: default_panel
       type(contact_spec_t) :: default_contact
       type(structure_spec_t) :: default_structure
       character(len=512) :: message
@@ -449,8 +456,8 @@ contains
 
       allocate (scene%materials(file%count('material')), scene%bodies(file%count('body')), &
                 scene%walls(file%count('wall')), scene%inlets(file%count('inlet')), scene%gauges(file%count('gauge')), &
-                scene%structures(file%count('structure')), scene%contacts(file%count('contact')))
-      allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1), one%gauges(1), one%structures(1), &
+                scene%panels(file%count('panel')), scene%structures(file%count('structure')), scene%contacts(file%count('contact')))
+      allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1), one%gauges(1), one%panels(1), one%structures(1), &
                 one%contacts(1))
       do g = 1, size(repeated_groups)
          group = trim(repeated_groups(g))
@@ -460,6 +467,7 @@ contains
             one%walls(1) = default_wall
             one%inlets(1) = default_inlet
             one%gauges(1) = default_gauge
+            one%panels(1) = default_panel
             one%contacts(1) = default_contact
             one%structures(1) = default_structure
             message = ''
@@ -479,6 +487,8 @@ contains
                scene%inlets(k) = one%inlets(1)
             case ('gauge')
                scene%gauges(k) = one%gauges(1)
+            case ('panel')
+               scene%panels(k) = one%panels(1)
             case ('contact')
                scene%contacts(k) = one%contacts(1)
             case ('structure')
@@ -510,6 +520,8 @@ contains
             where = group_context(file%path, group, k, material_detail(scene%inlets(k)%material))
          case ('gauge')
             where = group_context(file%path, group, k, name_detail(scene%gauges(k)%name))
+         case ('panel')
+            where = group_context(file%path, group, k, name_detail(scene%panels(k)%name))
          case ('contact')
             where = group_context(file%path, group, k)
          case ('structure')
@@ -597,7 +609,7 @@ contains
          call status%fail(file%path//': group &'//group//label//': '//trim(message))
          return
       end if
-      allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1), one%gauges(1), one%structures(1), &
+      allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1), one%gauges(1), one%panels(1), one%structures(1), &
                 one%contacts(1))
       associate (items => file%groups(g)%items)
          do i = 1, size(items)
@@ -723,6 +735,8 @@ contains
          call read_inlet_group(scene%inlets(k), ios, message, text)
       case ('gauge')
          call read_gauge_group(scene%gauges(k), ios, message, text)
+      case ('panel')
+         call read_panel_group(scene%panels(k), ios, message, text)
       case ('contact')
          call read_contact_group(scene%contacts(k), ios, message, text)
       case ('structure')

@@ -20,6 +20,7 @@ module scene_record
    use structure_group, only: structure_value
    use inlet_group, only: inlet_value
    use gauge_group, only: gauge_value
+   use panel_group, only: panel_value
    use contact_group, only: contact_value
    implicit none
    private
@@ -110,6 +111,8 @@ contains
          text = inlet_value(scene%inlets(k), name)
       case ('gauge')
          text = gauge_value(scene%gauges(k), name)
+      case ('panel')
+         text = panel_value(scene%panels(k), name)
       case ('contact')
          text = contact_value(scene%contacts(k), name)
       case ('structure')

@@ -21,8 +21,9 @@ module scene_validation
    use inlet_group, only: validate_inlet
    use body_validation, only: validate_body, check_body_has_particles
    use boundary_validation, only: validate_wall, validate_structure
-   use sensor_validation, only: validate_gauge_walls, validate_load_names
+   use sensor_validation, only: validate_gauge_walls, validate_panel_walls, validate_load_names
    use gauge_group, only: validate_gauge
+   use panel_group, only: validate_panel
    implicit none
    private
 
@@ -96,6 +97,14 @@ contains
       call validate_load_names(scene, path, status)
       if (.not. status%ok) return
       call validate_gauge_walls(scene, path, status)
+      if (.not. status%ok) return
+      if (allocated(scene%panels)) then
+         do i = 1, size(scene%panels)
+            call validate_panel(scene%panels, i, scene%grid, path, status)
+            if (.not. status%ok) return
+         end do
+      end if
+      call validate_panel_walls(scene, path, status)
       if (.not. status%ok) return
       if (allocated(scene%contacts)) then
          do i = 1, size(scene%contacts)

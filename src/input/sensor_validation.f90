@@ -1,10 +1,10 @@
-!> Checks of what a run measures that read other groups: the wall of a wall_pressure gauge (a gauge's own
-!> values: gauge_group) and the load namespace (the names of loads.csv: box sides that are walls, &wall,
+!> Checks of what a run measures that read other groups: the wall of a wall_pressure gauge or a panel (their
+!> own values: gauge_group, panel_group) and the load namespace (the names of loads.csv: box sides that are walls, &wall,
 !> &inlet, &body, &structure, unique and resolved).
 module sensor_validation
    use kinds, only: name_len
    use error_status, only: status_t
-   use scene_description, only: scene_t, wall_none, motion_none, gauge_wall_pressure
+   use scene_description, only: scene_t, wall_none, motion_none, gauge_wall_pressure, panel_load_cell
    use input_text, only: quoted_list, group_context, ordinal
    use input_checks, only: given_or, name_detail
    use scene_memory, only: body_count, wall_count, structure_count, inlet_count
@@ -13,7 +13,7 @@ module sensor_validation
    implicit none
    private
 
-   public :: validate_gauge_walls, validate_load_names
+   public :: validate_gauge_walls, validate_panel_walls, validate_load_names
 
    !> One name of the load namespace (box sides that are walls, &wall, &inlet, &body), for the
    !> uniqueness check: the resolved name, whether the scene gave it, and how messages name its place.
@@ -54,24 +54,61 @@ contains
                                 'wall, box side or structure the gauge lies on, as in loads.csv)')
                return
             end if
-            if (any(moving_surfaces(scene) == gauge%wall)) then
-               call status%fail(where//": variable wall names '"//trim(gauge%wall)//"', which moves (its "// &
-                                'motion): a wall_pressure gauge reads a fixed wall or structure')
-               return
-            end if
-            if (all(surfaces /= gauge%wall)) then
-               if (size(surfaces) == 0) then
-                  call status%fail(where//": variable wall names '"//trim(gauge%wall)//"', but the scene has no "// &
-                                   'wall, box side wall or structure')
-               else
-                  call status%fail(where//": variable wall must be the name of a wall, box side or structure, "// &
-                                   quoted_list(surfaces)//", got '"//trim(gauge%wall)//"'")
-               end if
-               return
-            end if
+            call check_surface_name(scene, surfaces, where, gauge%wall, 'a wall_pressure gauge', .false., status)
+            if (.not. status%ok) return
          end associate
       end do
    end subroutine validate_gauge_walls
+
+   !> A surface panel names the wall, box side or structure it lies on (fixed, as a wall_pressure gauge's);
+   !> a load cell may name one (moving or not) or none (every constraint in its box). That a surface panel
+   !> lies on its surface is checked when the walls are built.
+   subroutine validate_panel_walls(scene, path, status)
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: path
+      type(status_t), intent(inout) :: status
+      character(len=name_len), allocatable :: surfaces(:)
+      character(len=:), allocatable :: where
+      integer :: p
+      if (.not. allocated(scene%panels)) return
+      surfaces = surface_names(scene)
+      do p = 1, size(scene%panels)
+         associate (panel => scene%panels(p))
+            where = group_context(path, 'panel', p, name_detail(panel%name))
+            if (panel%kind == panel_load_cell) then
+               if (len_trim(panel%wall) > 0) &
+                  call check_surface_name(scene, surfaces, where, panel%wall, 'a load_cell', .true., status)
+            else if (len_trim(panel%wall) == 0) then
+               call status%fail(where//": variable wall is required for kind 'surface' (the name of the wall, box "// &
+                                'side or structure the panel lies on, as in loads.csv)')
+            else
+               call check_surface_name(scene, surfaces, where, panel%wall, 'a surface panel', .false., status)
+            end if
+            if (.not. status%ok) return
+         end associate
+      end do
+   end subroutine validate_panel_walls
+
+   !> `wall` (variable wall of the group at `where`) must be one of the scene's `surfaces`, and (unless
+   !> `may_move`) not a moving one: `who` reads a fixed surface.
+   subroutine check_surface_name(scene, surfaces, where, wall, who, may_move, status)
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: surfaces(:), where, wall, who
+      logical, intent(in) :: may_move
+      type(status_t), intent(inout) :: status
+      if (.not. may_move .and. any(moving_surfaces(scene) == wall)) then
+         call status%fail(where//": variable wall names '"//trim(wall)//"', which moves (its "// &
+                          'motion): '//who//' reads a fixed wall or structure')
+      else if (all(surfaces /= wall)) then
+         if (size(surfaces) == 0) then
+            call status%fail(where//": variable wall names '"//trim(wall)//"', but the scene has no "// &
+                             'wall, box side wall or structure')
+         else
+            call status%fail(where//": variable wall must be the name of a wall, box side or structure, "// &
+                             quoted_list(surfaces)//", got '"//trim(wall)//"'")
+         end if
+      end if
+   end subroutine check_surface_name
 
    !> The names of the scene's constraining surfaces, as loads.csv names them: box sides that are walls,
    !> &wall groups, &structure groups (given names or the defaults).

@@ -11,7 +11,7 @@ module output_directory
    use error_status, only: status_t
    use file_system, only: path_exists, make_directory, remove_file
    use output_layout, only: fields_folder, checkpoint_folder, fields_file, checkpoint_file, particles_xdmf, &
-                            grid_xdmf, latest_checkpoint, temporary_suffix, loads_csv, gauges_csv, bodies_csv, &
+                            grid_xdmf, latest_checkpoint, temporary_suffix, loads_csv, gauges_csv, bodies_csv, panels_csv, &
                             scene_nml, previous_scene_nml
    use status_broadcast, only: broadcast_status
    implicit none
@@ -102,6 +102,7 @@ contains
       call remove(trim(dir)//'/'//loads_csv, removed)
       call remove(trim(dir)//'/'//gauges_csv, removed)
       call remove(trim(dir)//'/'//bodies_csv, removed)
+      call remove(trim(dir)//'/'//panels_csv, removed)
       call remove(trim(dir)//'/'//scene_nml, removed)
       index = 1
       do while (path_exists(trim(dir)//'/'//previous_scene_nml(index)) .and. removed)

@@ -18,10 +18,11 @@ module output_layout
    character(len=*), parameter, public :: grid_xdmf = 'grid.xmf'
    character(len=*), parameter, public :: latest_checkpoint = 'latest'
    character(len=*), parameter, public :: temporary_suffix = '.tmp'
-   !> The time series of loads, gauges and bodies (load_records, docs/output.md).
+   !> The time series of loads, gauges, panels and bodies (load_records, docs/output.md).
    character(len=*), parameter, public :: loads_csv = 'loads.csv'
    character(len=*), parameter, public :: gauges_csv = 'gauges.csv'
    character(len=*), parameter, public :: bodies_csv = 'bodies.csv'
+   character(len=*), parameter, public :: panels_csv = 'panels.csv'
    !> The resolved scene of the run (provenance).
    character(len=*), parameter, public :: scene_nml = 'scene.nml'
 

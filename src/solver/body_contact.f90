@@ -296,8 +296,8 @@ contains
       type(grid_t), intent(in) :: grid
       real(rp), intent(inout) :: impulse(:, :)
       real(rp), intent(inout) :: field_impulse(:, :, :)
-      real(rp) :: friction(constraints%count(), self%fields), share(size(impulse, 1), constraints%count())
-      integer :: f, o, dim
+      real(rp) :: friction(constraints%count(), self%fields), share(size(impulse, 1), size(impulse, 2))
+      integer :: f, o, dim, n
       dim = self%dim
       friction = self%wall_friction(constraints%structure)
       call constraints%constrain(dim, self%velocity(1:dim, :), self%common_mass, impulse)
@@ -306,8 +306,10 @@ contains
          share = 0.0_rp
          call constraints%constrain(dim, self%velocity(o + 1:o + dim, :), &
                                     grid%accumulated(self%field_row + (f - 1) * self%stride, :), share, friction(:, f))
+         ! the sensors' columns after the constraints' take the body fields' part too (a panel under debris)
          impulse = impulse + share
-         field_impulse(:, :, f) = field_impulse(:, :, f) + share
+         n = constraints%count()
+         field_impulse(:, :, f) = field_impulse(:, :, f) + share(:, 1:n)
       end do
       self%increment = self%velocity - self%increment
    end subroutine contact_apply_walls

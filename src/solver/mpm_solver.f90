@@ -21,8 +21,8 @@ module mpm_solver
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use error_status, only: status_t
    use communication_counters, only: count_collective, comm_time_step, comm_balance, comm_other, real_bytes, int8_bytes
-   use scene_description, only: scene_t, run_control_t, model_newtonian_fluid, gauge_wall_pressure
-   use wall_pressure_taps, only: wall_sensor_t
+   use scene_description, only: scene_t, run_control_t, model_newtonian_fluid
+   use sensor_setup, only: attach_scene_sensors, check_sensors_on_surfaces
    use domain_decomposition, only: domain_t, layout_dims, fit_box, min_slab_width
    use shape_functions, only: shape_function_kind, ghost_node_layers, shape_linear
    use load_balance, only: balanced_layout
@@ -91,8 +91,9 @@ module mpm_solver
       !> the features of the step the scene declares (step_component): inflow, volume correction
       type(component_slot_t), allocatable :: components(:)
       type(wall_loads_t) :: loads               !< impulse of every wall since the last row of loads.csv
-      !> per wall-pressure gauge, how far its point lies from the surface of its wall [m] (checked at the start)
-      real(rp), allocatable :: sensor_offset(:)
+      !> per sensor on a wall (sensor_setup), how far it lies from the surface of its wall [m] and the part of a
+      !> panel's area off the wettable surface (checked at the start)
+      real(rp), allocatable :: sensor_offset(:), sensor_outside(:)
       type(fluid_gauges_t) :: gauges            !< the &gauge sensors (gauges.csv)
       type(body_motion_t) :: bodies             !< the solid bodies (bodies.csv)
       !> the grid's velocity field(s) and the transfers through them: one field, or with &contact one per body
@@ -179,7 +180,7 @@ contains
       ! inlet ids start after every id of the bodies (their whole lattices, not just the particles kept)
       call build_step_components(self%scene, scene_id_count(self%scene), self%gravity, self%constraints, &
                                  self%components)
-      call check_wall_sensors(self, status)
+      call check_sensors_on_surfaces(self%scene, self%grid%h, self%sensor_offset, self%sensor_outside, status)
       if (.not. status%ok) return
       call self%gauges%init(scene, frame, self%gravity)
       call self%bodies%init(scene, self%materials, frame, self%gravity)
@@ -238,56 +239,14 @@ contains
    end subroutine solver_check_particle_memory
 
    !> The boundary constraints (walls, box sides, inlets' walls, structures, with their local nodes, in the
-   !> order of the entries of loads.csv) and the wall-pressure sensors.
+   !> order of the entries of loads.csv) and the sensors on them (gauges, panels, load cells).
    subroutine build_boundaries(self)
       type(solver_t), intent(inout) :: self
       call build_constraints(self%scene, self%grid, self%time, self%constraints)
-      call attach_sensors(self)
+      call attach_scene_sensors(self%scene, self%loads%names, self%grid, self%constraints, self%sensor_offset, &
+                                self%sensor_outside)
    end subroutine build_boundaries
 
-   !> The wall-pressure gauges (in gauges.csv order) on the walls of the loads.csv entries they name.
-   subroutine attach_sensors(self)
-      type(solver_t), intent(inout) :: self
-      type(wall_sensor_t), allocatable :: sensors(:)
-      integer, allocatable :: entries(:)
-      integer :: g, e
-      allocate (sensors(0), entries(0))
-      if (allocated(self%scene%gauges)) then
-         do g = 1, size(self%scene%gauges)
-            associate (gauge => self%scene%gauges(g))
-               if (gauge%kind /= gauge_wall_pressure) cycle
-               sensors = [sensors, wall_sensor_t(slot=size(sensors) + 1, point=gauge%point, radius=gauge%radius)]
-               e = findloc(self%loads%names, gauge%wall, 1)
-               entries = [entries, e]
-            end associate
-         end do
-      end if
-      if (allocated(self%sensor_offset)) deallocate (self%sensor_offset)
-      allocate (self%sensor_offset(size(sensors)))
-      if (size(sensors) > 0) call self%constraints%attach_sensors(self%grid, sensors, entries, self%sensor_offset)
-   end subroutine attach_sensors
-
-   !> A wall-pressure gauge's point must lie on its wall's surface (within half a cell, on the rank that
-   !> has the wall: every rank builds all walls).
-   subroutine check_wall_sensors(self, status)
-      type(solver_t), intent(in) :: self
-      type(status_t), intent(inout) :: status
-      integer :: g, slot
-      slot = 0
-      if (.not. allocated(self%scene%gauges)) return
-      do g = 1, size(self%scene%gauges)
-         associate (gauge => self%scene%gauges(g))
-            if (gauge%kind /= gauge_wall_pressure) cycle
-            slot = slot + 1
-            if (self%sensor_offset(slot) <= 0.5_rp * self%grid%h) cycle
-            call status%fail(group_context(self%scene%source_file, 'gauge', g, "name '"//trim(gauge%name)//"'")// &
-                             ': variable point lies '//trim(real_text(self%sensor_offset(slot)))// &
-                             " m from the surface of wall '"//trim(gauge%wall)// &
-                             "' (a wall_pressure gauge must lie on it, within half a cell)")
-            return
-         end associate
-      end do
-   end subroutine check_wall_sensors
 
    !> A structure displaces the fluid: the particles of fluid bodies seeded inside it (phi < 0) are not
    !> kept, so that a structure can stand in water at rest [R]. Solid bodies are not cut (check_structures_clear

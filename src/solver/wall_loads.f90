@@ -8,9 +8,10 @@
 !> per step. A row sums the ranks' impulses (one reduction) and divides by the interval's length,
 !> F = -J / (t - t_prev), so that no impulse is lost between rows. Each rank's impulse is saved in
 !> checkpoints (checkpoint.f90): a restart on the same ranks continues the rows bit for bit.
-!> Wall-pressure gauges (wall_pressure_taps) add one column each after the walls' in the step's record and
-!> one entry each after loads.csv's, summed and saved the same way but written to gauges.csv: row_values
-!> leaves their interval means in `sensor_pressure`.
+!> The sensors on the walls (surface_sensors: wall-pressure gauges, then panels and load cells) add one
+!> column each after the walls' in the step's record and one entry each after loads.csv's, summed and saved
+!> the same way but written to gauges.csv and panels.csv: row_values leaves the gauges' interval means in
+!> `sensor_pressure` and the panels' in `panel_values`.
 !> With contact body fields (body_contact), every structure has one more entry per body field,
 !> `<structure>_by_<body>`: the part of the structure's impulse given to that body's field (nodes and
 !> safeguard); the structure's own entry keeps the total, the rest of which is the common field's.
@@ -18,8 +19,9 @@ module wall_loads
    use kinds, only: rp, name_len
    use communication_counters, only: count_collective, comm_records, real_bytes
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_SUM
-   use scene_description, only: scene_t, gauge_wall_pressure
+   use scene_description, only: scene_t, gauge_wall_pressure, panel_load_cell
    use constraint, only: impulse_rows
+   use surface_sensors, only: pressure_row
    use load_entries, only: load_entry_t, scene_load_entries, entries_before, entry_structure
    use body_contact, only: contact_body_names
    use world_frame, only: frame_t
@@ -39,9 +41,15 @@ module wall_loads
       !> (impulse_rows, wall, field) body field f's part of step_impulse(:, wall)
       real(rp), allocatable :: field_impulse(:, :, :)
       real(rp), allocatable :: impulse(:, :)             !< (impulse_rows, entry) this rank, since last row
-      integer :: sensors = 0                             !< wall-pressure gauges: entries after the names'
+      integer :: sensors = 0                             !< gauges, panels, load cells: entries after the names'
+      integer :: pressure_gauges = 0                     !< wall-pressure gauges: the first sensors
       !> per wall-pressure gauge, its mean pressure over the interval of the last row [Pa]
       real(rp), allocatable :: sensor_pressure(:)
+      !> panels.csv: per panel its name and whether it is a load cell (no pressure column)
+      character(len=name_len), allocatable :: panel_names(:)
+      logical, allocatable :: load_cell(:)
+      !> the panels' row of the interval of the last row, in panels.csv's column order [Pa, N; N/m in 2-D]
+      real(rp), allocatable :: panel_values(:)
       !> time of the last row of loads.csv, gauges.csv and bodies.csv: the start of the interval now
       !> accumulating (0 at the start of a run; saved in checkpoints)
       real(rp) :: last_row_time = 0.0_rp
@@ -51,6 +59,7 @@ module wall_loads
       procedure :: end_step => loads_end_step
       procedure :: row_values => loads_row_values
       procedure :: column_names => loads_column_names
+      procedure :: panel_column_names => loads_panel_column_names
    end type wall_loads_t
 
 contains
@@ -82,9 +91,15 @@ contains
             self%names = [self%names, entry]
          end do
       end do
-      self%sensors = 0
-      if (allocated(scene%gauges)) self%sensors = count(scene%gauges%kind == gauge_wall_pressure)
-      allocate (self%impulse(impulse_rows, size(self%names) + self%sensors), self%sensor_pressure(self%sensors))
+      self%pressure_gauges = 0
+      if (allocated(scene%gauges)) self%pressure_gauges = count(scene%gauges%kind == gauge_wall_pressure)
+      allocate (self%panel_names(0), self%load_cell(0), self%panel_values(0))
+      if (allocated(scene%panels)) then
+         self%panel_names = scene%panels%name
+         self%load_cell = scene%panels%kind == panel_load_cell
+      end if
+      self%sensors = self%pressure_gauges + size(self%panel_names)
+      allocate (self%impulse(impulse_rows, size(self%names) + self%sensors), self%sensor_pressure(self%pressure_gauges))
       self%impulse = 0.0_rp
       self%sensor_pressure = 0.0_rp
    end subroutine loads_init
@@ -166,12 +181,35 @@ contains
             at = at + 3
          end if
       end do
-      ! a sensor's column holds sum w dp . n / |patch|: p dt
-      do s = 1, self%sensors
-         self%sensor_pressure(s) = total(1, size(self%names) + s) / interval
+      ! a gauge's column holds sum w dp . n / |patch| (p dt) in its pressure row
+      do s = 1, self%pressure_gauges
+         self%sensor_pressure(s) = total(pressure_row, size(self%names) + s) / interval
+      end do
+      ! a panel's: the same and sum w dp (-F dt) in its force rows; a load cell's the force rows only
+      self%panel_values = [real(rp) ::]
+      do s = 1, size(self%panel_names)
+         e = size(self%names) + self%pressure_gauges + s
+         if (.not. self%load_cell(s)) self%panel_values = [self%panel_values, total(pressure_row, e) / interval]
+         self%panel_values = [self%panel_values, -frame%world_vector(total(1:d, e)) / interval]
       end do
       self%impulse = 0.0_rp
    end function loads_row_values
+
+   !> Column names of panels.csv after `time`, in the order of panel_values: per panel _pressure (not for a
+   !> load cell) and the force _fx, _fy[, _fz].
+   function loads_panel_column_names(self) result(columns)
+      class(wall_loads_t), intent(in) :: self
+      character(len=name_len + 9), allocatable :: columns(:)
+      character(len=*), parameter :: force(3) = ['_fx', '_fy', '_fz']
+      integer :: p, k
+      allocate (columns(0))
+      do p = 1, size(self%panel_names)
+         if (.not. self%load_cell(p)) columns = [character(len=name_len + 9) :: columns, trim(self%panel_names(p))//'_pressure']
+         do k = 1, self%dim
+            columns = [character(len=name_len + 9) :: columns, trim(self%panel_names(p))//force(k)]
+         end do
+      end do
+   end function loads_panel_column_names
 
    !> Column names of loads.csv after `time`, in the order of row_values.
    function loads_column_names(self) result(columns)

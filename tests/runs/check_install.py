@@ -28,6 +28,7 @@ def main():
     done = subprocess.run([cmake, "--install", build, "--prefix", prefix], capture_output=True, text=True)
     checks.check(done.returncode == 0, "cmake --install into a temporary prefix", done.stdout[-1000:] + done.stderr)
     expected = ["bin/flotsam", "bin/flotsam_bench", "bin/flotsam-study", "bin/flotsam-plot-loads",
+                "bin/flotsam-load-report", "share/flotsam/python/load_signals.py",
                 "bin/flotsam-plot-diagnostics", "bin/flotsam-render-step", "bin/flotsam-crowding-map",
                 "share/flotsam/slurm/flotsam.sbatch", "share/flotsam/slurm/study.sbatch",
                 "share/flotsam/inputs/hydrostatic_tank.nml", "share/flotsam/inputs/studies/tank_ppc.study",
@@ -62,6 +63,11 @@ def main():
                           cwd=elsewhere, env=environment, capture_output=True, text=True)
     checks.check(plot.returncode == 0 and os.path.exists(os.path.join(elsewhere, "d.png")),
                  "flotsam-plot-diagnostics plots it", plot.stderr[-1000:])
+    report = subprocess.run([os.path.join(prefix, "bin", "flotsam-load-report"), "run", "--no-plot"],
+                            cwd=elsewhere, env=environment, capture_output=True, text=True)
+    checks.check(report.returncode == 0 and os.path.exists(os.path.join(elsewhere, "run", "load_report.csv")),
+                 "flotsam-load-report (with the installed load_signals.py) reports on its loads",
+                 report.stdout[-500:] + report.stderr[-1000:])
 
     with open(os.path.join(elsewhere, "tiny.study"), "w") as f:
         f.write(f"[study]\nscene = {scene}\nranks = 2\noutput = tiny\n[parameters]\nrun max_steps = [10]\n")
