@@ -128,6 +128,8 @@ def main():
     unit = "N/m" if two_d else "N"
     cutoff = load_signals.DEFAULT_CUTOFF_HZ if arguments.cutoff is None else arguments.cutoff
     force = load_signals.Event(loads["time"], loads[column], True, cutoff)
+    if force.note:
+        print(f"design_check: note: {force.note}")
 
     rows = []   # (quantity, value, unit, how)
     gauges, _ = read_csv(arguments.folder, "gauges")
