@@ -28,7 +28,7 @@ def main():
     done = subprocess.run([cmake, "--install", build, "--prefix", prefix], capture_output=True, text=True)
     checks.check(done.returncode == 0, "cmake --install into a temporary prefix", done.stdout[-1000:] + done.stderr)
     expected = ["bin/flotsam", "bin/flotsam_bench", "bin/flotsam-study", "bin/flotsam-plot-loads",
-                "bin/flotsam-load-report", "bin/flotsam-design-check", "share/flotsam/python/load_signals.py",
+                "bin/flotsam-load-report", "bin/flotsam-design-check", "share/flotsam/python/load_signals.py", "share/flotsam/python/ensemble.py",
                 "bin/flotsam-plot-diagnostics", "bin/flotsam-render-step", "bin/flotsam-crowding-map",
                 "share/flotsam/slurm/flotsam.sbatch", "share/flotsam/slurm/study.sbatch",
                 "share/flotsam/inputs/hydrostatic_tank.nml", "share/flotsam/inputs/studies/tank_ppc.study",

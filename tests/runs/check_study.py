@@ -13,7 +13,12 @@
   * the measures: [load] on the tank (its side wall's force, exact at rest on the aligned grid:
     rho g H^2 / 2 = 51 200 N/m) and [surge] on a coarse dam break of Koshizuka & Oka (inputs/dam_break_ko.nml,
     10 cells per L): the front at the measured times, each within 10 % of the measurement while the
-    front has not yet run ahead (T < 1.6), and growing with T; a [surge] without its width is refused.
+    front has not yet run ahead (T < 1.6), and growing with T; a [surge] without its width is refused;
+  * [ensemble] (issue 52): 20 random cases of a block carried onto a column (position along the flume,
+    initial velocity) in one command: results.csv with 20 rows and their samples, ensemble.csv with the
+    column's filtered peak and impulse (median between the 10 % and 90 % quantiles, the steady count),
+    ensemble.png; the same seed gives the same cases (--dry-run), another seed others, and case i does
+    not depend on the number of cases; a distribution the study does not know is refused.
 
 usage: check_study.py <flotsam> <mpiexec> <tests/runs/scenes> <scripts folder>"""
 
@@ -99,8 +104,66 @@ def check_surge(checks, scripts, inputs, work, flotsam_path, mpiexec):
                  bad.stderr)
 
 
+def write_ensemble_study(path, scene, output, seed, cases):
+    with open(path, "w") as f:
+        f.write(f"[study]\nscene = {scene}\nranks = 1\noutput = {output}\n"
+                f"[ensemble]\ncases = {cases}\nseed = {seed}\nloads = column\n"
+                "[random]\nbody:block shift = uniform([-0.02, 0.0], [0.02, 0.0])\n"
+                "body:block velocity = normal([0.5, 0.0], [0.1, 0.0])\n")
+
+
+def check_ensemble(checks, scripts, scenes, work, flotsam_path, mpiexec):
+    """[ensemble]: random debris cases, their distribution, reproducible."""
+    scene = os.path.join(scenes, "structures", "column_flow.nml")
+    study = os.path.join(work, "ensemble.study")
+    out = os.path.join(work, "ensemble")
+    write_ensemble_study(study, scene, out, 7, 20)
+    base = [sys.executable, os.path.join(scripts, "study")]
+    result = subprocess.run(base + [study, "--flotsam", flotsam_path, "--mpiexec", mpiexec, "--jobs", "2"],
+                            capture_output=True, text=True)
+    summary = os.path.join(out, "ensemble.csv")
+    if not checks.check(result.returncode == 0 and os.path.exists(summary), "[ensemble]: 20 cases run in one command",
+                        result.stdout[-1500:] + result.stderr[-1500:]):
+        return
+    rows = read_results(os.path.join(out, "results.csv"))
+    checks.check(len(rows) == 20 and all(r["sample"] for r in rows) and all(r["body:block shift"] for r in rows),
+                 f"[ensemble]: results.csv has a row per case with its sample ({len(rows)} rows)")
+    with open(summary) as f:
+        lines = [line for line in f if not line.startswith("#")]
+    table = {r["measure"]: r for r in csv.DictReader(lines)}
+    peak = table.get("column_peak_filtered")
+    ok = peak is not None and int(peak["cases"]) == 20 and \
+        float(peak["q10"]) <= float(peak["median"]) <= float(peak["q90"]) and float(peak["median"]) > 0 and \
+        1 <= int(peak["cases_for_steady_median"]) <= 20
+    checks.check(ok, "[ensemble]: ensemble.csv: the column's filtered peak over 20 cases, q10 <= median <= q90, "
+                 "the steady count", str(peak))
+    peaks = sorted(float(r["column_peak_filtered"]) for r in rows)
+    checks.check(peak is not None and abs(float(peak["median"]) - 0.5 * (peaks[9] + peaks[10])) <= 1e-9 * peaks[10],
+                 "[ensemble]: its median is the median of results.csv's column_peak_filtered")
+    checks.check("column_impulse" in table and float(table["column_impulse"]["median"]) > 0,
+                 "[ensemble]: and the impulse of the event")
+    checks.check(os.path.getsize(os.path.join(out, "ensemble.png")) > 5000, "[ensemble]: ensemble.png (box plot)")
+    checks.check(peaks[0] < peaks[-1], f"[ensemble]: the cases differ (peaks {peaks[0]:.4g} .. {peaks[-1]:.4g} N/m)")
+
+    def dry(seed, cases):
+        path = os.path.join(work, f"dry_{seed}_{cases}.study")
+        write_ensemble_study(path, scene, os.path.join(work, "dry"), seed, cases)
+        return subprocess.run(base + [path, "--dry-run"], capture_output=True, text=True).stdout.splitlines()
+
+    same, other, fewer = dry(7, 20), dry(8, 20), dry(7, 5)
+    checks.check(same == dry(7, 20) and len(same) == 20, "[ensemble]: the same seed gives the same cases")
+    checks.check(same != other, "[ensemble]: another seed gives other cases")
+    checks.check(fewer == same[:5], "[ensemble]: case i does not depend on the number of cases")
+    with open(os.path.join(work, "bad_ensemble.study"), "w") as f:
+        f.write(f"[study]\nscene = {scene}\n[ensemble]\ncases = 3\nseed = 1\n[random]\n"
+                "body:block rotation = gauss(0.0, 5.0)\n")
+    bad = subprocess.run(base + [os.path.join(work, "bad_ensemble.study"), "--dry-run"], capture_output=True, text=True)
+    checks.check(bad.returncode != 0 and "expected uniform(low, high), normal(mean, sd) or choice" in bad.stderr,
+                 "[ensemble]: an unknown distribution is refused with the file, section and variable", bad.stderr)
+
+
 def main():
-    flotsam_path, mpiexec, _scenes, rest = main_arguments()
+    flotsam_path, mpiexec, scenes, rest = main_arguments()
     flotsam_path = os.path.abspath(flotsam_path)
     scripts = os.path.abspath(rest[0])
     inputs = os.path.join(os.path.dirname(scripts), "inputs")
@@ -246,6 +309,7 @@ def main():
     bad_case = run("--case", "9")
     checks.check(bad_case.returncode != 0 and "--case 9: the study has cases 1 to 4" in bad_case.stderr,
                  "--case out of range is refused", bad_case.stderr)
+    check_ensemble(checks, scripts, scenes, work, flotsam_path, mpiexec)
     leftovers = glob.glob(os.path.join(work, "**", "*.tmp"), recursive=True)
     checks.check(not leftovers, "no temporary files left", str(leftovers))
     raise SystemExit(checks.summary())
