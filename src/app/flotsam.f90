@@ -276,7 +276,7 @@ contains
    !> A valid scene likely to fail (scene_advice): one warning line from rank 0; the run goes on.
    subroutine print_advice()
       character(len=:), allocatable :: advice
-      advice = scene_advice(scene)
+      advice = scene_advice(scene, new_line('a')//'flotsam: warning: ')
       if (rank == 0 .and. len(advice) > 0) write (error_unit, '(a)') 'flotsam: warning: '//advice
    end subroutine print_advice
 

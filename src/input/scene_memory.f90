@@ -4,13 +4,17 @@
 module scene_memory
    use kinds, only: rp, i8
    use error_status, only: status_t
-   use scene_description, only: scene_t, has_velocity_file, model_newtonian_fluid
+   use scene_description, only: scene_t, has_velocity_file, model_newtonian_fluid, model_linear_elastic
    use input_text, only: int_text, group_context
    use memory_budget, only: memory_budget_t, byte_text
    use body_lattice, only: has_points_file, body_bounds, count_particles
    use input_checks, only: count_text
    implicit none
    private
+
+   !> An elastic body's impact peak converges from about this many cells across its smallest extent
+   !> (docs/contact.md, "The debris peak against resolution": 8, 10 and 20 cells agree within 5 %)
+   real(rp), parameter :: resolved_body_cells = 8.0_rp
 
    public :: check_scene_memory, scene_particle_count, memory_estimate_per_rank, scene_advice
    public :: body_count, wall_count, structure_count, inlet_count, gauge_count, panel_count
@@ -103,18 +107,38 @@ contains
                real(bytes_per_node(dim) + contact_field_count(scene) * bytes_per_field_node(dim), rp) * nodes) / ranks
    end function memory_estimate_per_rank
 
-   !> Advice on a valid scene that is likely to fail, '' when there is none: the run prints it as a warning
-   !> after its banner. APIC on the multilinear grid with a fluid: its small-mass node where a free surface
-   !> rises through a row of nodes blows up at any step (docs/theory.md, "APIC" and section 3.6).
-   function scene_advice(scene) result(text)
+   !> Advice on a valid scene that is likely to fail, or whose answer the grid bounds, '' when there is none:
+   !> the run prints it as warnings after its banner (one line each, `separator` between them). APIC on the
+   !> multilinear grid with a fluid: its small-mass node where a free surface rises through a row of nodes
+   !> blows up at any step (docs/theory.md, "APIC" and section 3.6). An elastic body fewer than
+   !> resolved_body_cells cells across: the peak of its impact on a structure grows with refinement until
+   !> it has about that many (docs/contact.md, "The debris peak against resolution").
+   function scene_advice(scene, separator) result(text)
       type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: separator
       character(len=:), allocatable :: text
+      real(rp) :: lo(3), hi(3), cells
+      character(len=24) :: across
+      integer :: b, dim
       text = ''
-      if (scene%run%transfer /= 'apic' .or. scene%grid%shape_function /= 'linear') return
-      if (.not. any(scene%materials%model == model_newtonian_fluid)) return
-      text = "&run transfer = 'apic' with &grid shape_function = 'linear' and a fluid: APIC blows up where a free "// &
-             "surface rises through a row of nodes (waves, bores, moving walls); shape_function = 'bspline2' runs "// &
-             "them (docs/theory.md, APIC)"
+      if (scene%run%transfer == 'apic' .and. scene%grid%shape_function == 'linear' .and. &
+          any(scene%materials%model == model_newtonian_fluid)) &
+         text = "&run transfer = 'apic' with &grid shape_function = 'linear' and a fluid: APIC blows up where a free "// &
+                "surface rises through a row of nodes (waves, bores, moving walls); shape_function = 'bspline2' runs "// &
+                "them (docs/theory.md, APIC)"
+      dim = scene%grid%dim
+      do b = 1, body_count(scene)
+         if (scene%materials(scene%bodies(b)%material_index)%model /= model_linear_elastic) cycle
+         call body_bounds(scene, b, lo, hi)
+         cells = minval(hi(1:dim) - lo(1:dim)) / scene%grid%cell_size
+         if (cells >= resolved_body_cells) cycle
+         write (across, '(f0.1)') cells
+         if (len(text) > 0) text = text//separator
+         text = text//"&body '"//trim(scene%bodies(b)%name)//"' (material '"//trim(scene%bodies(b)%material)// &
+                "') is "//trim(across)//' cells across: the peak of its impact on a structure is '// &
+                'resolution-bound below about '//int_text(nint(resolved_body_cells))//' cells across (its impulse is not; '// &
+                'docs/contact.md, "The debris peak against resolution")'
+      end do
    end function scene_advice
 
    !> Bodies that get a velocity field of their own: those of a material some `&contact` names.
