@@ -99,6 +99,9 @@ module constraint
       procedure :: may_cut_support => always_may_cut
       !> narrow a sensor's wettable interval along grid axis `along` (a planar wall across it)
       procedure :: narrow_wet_interval => keep_interval
+      !> narrow a sensor's wettable interval lo .. hi of s along the line point + s tangent (grid frame; a
+      !> planar wall the line crosses)
+      procedure :: narrow_along_line => keep_line_interval
       procedure :: set_condition
       procedure :: set_activity
       procedure :: place
@@ -434,6 +437,13 @@ contains
       real(rp), intent(in) :: x(:), ahead, extra, margin
       may = .true.
    end function always_may_cut
+
+   subroutine keep_line_interval(self, grid, point, tangent, lo, hi)
+      class(constraint_t), intent(in) :: self
+      type(grid_t), intent(in) :: grid
+      real(rp), intent(in) :: point(:), tangent(:)
+      real(rp), intent(inout) :: lo, hi
+   end subroutine keep_line_interval
 
    subroutine keep_interval(self, grid, along, point, wet_lo, wet_hi)
       class(constraint_t), intent(in) :: self

@@ -252,6 +252,16 @@ contains
                sensor%point = 0.0_rp
                sensor%point(1:dim) = x - phi * sensor%normal(1:dim)
                call tangent_axes(sensor%normal(1:dim), dim, tangents, axes)
+               if (.not. axes .and. sensor%kind == sensor_panel) then
+                  ! the tangent lines through the panel's centre, cut by the planar walls they cross
+                  do k = 1, dim - 1
+                     do v = 1, self%count()
+                        if (v == w) cycle
+                        call self%items(v)%item%narrow_along_line(grid, sensor%point(1:dim), tangents(:, k), &
+                                                                  sensor%tangent_lo(k), sensor%tangent_hi(k))
+                     end do
+                  end do
+               end if
                if (axes) then
                   do k = 1, dim - 1
                      along = maxloc(abs(tangents(:, k)), 1)

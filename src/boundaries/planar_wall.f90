@@ -30,6 +30,7 @@ module planar_wall
       procedure :: clearly_in_front => plane_clearly_in_front
       procedure :: may_cut_support => plane_may_cut_support
       procedure :: narrow_wet_interval => plane_narrows_interval
+      procedure :: narrow_along_line => plane_narrows_line
       procedure :: in_extent
    end type planar_wall_t
 
@@ -156,6 +157,28 @@ contains
          wet_hi = min(wet_hi, self%point(along))
       end if
    end subroutine plane_narrows_interval
+
+   !> The line point + s tangent (grid frame) crosses the wall at s* inside its extent: the wettable part of
+   !> it is s >= s* where the tangent points into the material (t . n > 0), else s <= s*. A line along the
+   !> wall (|t . n| < 1e-6) is not narrowed.
+   subroutine plane_narrows_line(self, grid, point, tangent, lo, hi)
+      class(planar_wall_t), intent(in) :: self
+      type(grid_t), intent(in) :: grid
+      real(rp), intent(in) :: point(:), tangent(:)
+      real(rp), intent(inout) :: lo, hi
+      real(rp) :: along, crossing
+      integer :: d
+      d = size(point)
+      along = dot_product(tangent(1:d), self%normal(1:d))
+      if (abs(along) < 1.0e-6_rp) return
+      crossing = dot_product(self%point(1:d) - point(1:d), self%normal(1:d)) / along
+      if (.not. self%in_extent(grid, point(1:d) + crossing * tangent(1:d))) return
+      if (along > 0.0_rp) then
+         lo = max(lo, crossing)
+      else
+         hi = min(hi, crossing)
+      end if
+   end subroutine plane_narrows_line
 
    !> Put the wall at displacement d from its place in the scene (point and extent); an unbounded side stays
    !> unbounded (huge + d rounds to huge).

@@ -20,8 +20,9 @@
 !> part of each in the patch; the weights of patches tiling a face add up to 1 at every node, so their
 !> loads add up to the face's. The wetted interval is where the surface can carry fluid along a tangent
 !> that is a grid axis: the scene box, cut by the planar walls normal to that axis (a floor below a sensor
-!> in a corner); on a surface whose tangents are not grid axes (a turned grid, a curved structure) it is
-!> unbounded and the weights are approximate near an edge.
+!> in a corner); on a surface whose tangents are not grid axes (a turned grid, a curved structure) a
+!> gauge's is unbounded, a panel's cut by the planar walls its tangent lines cross, and the weights are
+!> approximate near an edge.
 !> A load cell is a box of the scene: every constrained node in it (lower <= x < upper, world frame) is a
 !> tap of weight 1, so that load cells tiling a region add up to the load on it.
 !>
@@ -58,6 +59,9 @@ module surface_sensors
       real(rp) :: patch_lo(2) = 0.0_rp, patch_hi(2) = 0.0_rp
       !> along grid axis k (a tangent), the interval of the surface that can be wetted
       real(rp) :: wet_lo(3) = -huge(1.0_rp), wet_hi(3) = huge(1.0_rp)
+      !> a panel on a surface whose tangents are not grid axes: along tangent k, the wettable interval of the
+      !> tangent coordinate (the planar walls its line crosses)
+      real(rp) :: tangent_lo(2) = -huge(1.0_rp), tangent_hi(2) = huge(1.0_rp)
       !> a panel on a face whose tangents are grid axes: the consistent weights c_k(j) of the nodes along
       !> each tangent k (consistent_weights), the first of which lies at first_node(k)
       logical :: consistent = .false.
@@ -352,8 +356,9 @@ contains
             if (sensor%kind == sensor_panel) s = min(max(s, lo), hi)
          else
             s = dot_product(foot - sensor%point(1:dim), tangents(:, k))
-            lo = -huge(1.0_rp)
-            hi = huge(1.0_rp)
+            lo = sensor%tangent_lo(k)
+            hi = sensor%tangent_hi(k)
+            if (sensor%kind == sensor_panel) s = min(max(s, lo), hi)
          end if
          ! the patch cut to the wetted interval, and the part of it the node's hat covers
          area = area * max(0.0_rp, min(sensor%patch_hi(k), hi) - max(sensor%patch_lo(k), lo))
