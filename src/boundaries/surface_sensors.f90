@@ -21,8 +21,8 @@
 !> loads add up to the face's. The wetted interval is where the surface can carry fluid along a tangent
 !> that is a grid axis: the scene box, cut by the planar walls normal to that axis (a floor below a sensor
 !> in a corner); on a surface whose tangents are not grid axes (a turned grid, a curved structure) a
-!> gauge's is unbounded, a panel's cut by the planar walls its tangent lines cross, and the weights are
-!> approximate near an edge.
+!> gauge's is unbounded, a panel's cut by the planar walls its tangent lines cross, and a panel reads the
+!> nodes through a wider hat (turned_reach_cells): the weights are approximate there.
 !> A load cell is a box of the scene: every constrained node in it (lower <= x < upper, world frame) is a
 !> tap of weight 1, so that load cells tiling a region add up to the load on it.
 !>
@@ -36,6 +36,12 @@ module surface_sensors
 
    !> Normals within this cosine count as the sensor's face (a box's other faces are at 90 degrees).
    real(rp), parameter :: same_face_cosine = 0.7_rp
+   !> A panel on a surface whose tangents are not grid axes (a turned grid) reads each node's load through a
+   !> hat of this many cells' half-width about its foot point instead of one: the staircase of nodes such a
+   !> wall constrains carries loads that vary from node to node, and a one-cell hat split them at a panel's
+   !> edge by the foot point's place (a one-cell panel read +41 % on the tank turned by 30 degrees; with 4
+   !> cells -0.4 %; docs/loads.md) [R]. A pressure distribution along such a wall is resolved to about that.
+   real(rp), parameter :: turned_reach_cells = 4.0_rp
    !> Consistent weights below this are left out: the patches tiling a face then share every node's load
    !> out to 1e-14 of it.
    real(rp), parameter :: negligible_weight = 1.0e-15_rp
@@ -339,7 +345,7 @@ contains
       integer, intent(in) :: dim
       real(rp), intent(in) :: h, foot(dim)
       real(rp), intent(out) :: weight, area
-      real(rp) :: tangents(dim, dim - 1), s, lo, hi, a, b, whole
+      real(rp) :: tangents(dim, dim - 1), s, lo, hi, a, b, whole, reach
       logical :: axes
       integer :: k, along
       call tangent_axes(sensor%normal(1:dim), dim, tangents, axes)
@@ -362,17 +368,19 @@ contains
          end if
          ! the patch cut to the wetted interval, and the part of it the node's hat covers
          area = area * max(0.0_rp, min(sensor%patch_hi(k), hi) - max(sensor%patch_lo(k), lo))
-         lo = max(lo, s - h)
-         hi = min(hi, s + h)
+         reach = h
+         if (.not. axes .and. sensor%kind == sensor_panel) reach = turned_reach_cells * h
+         lo = max(lo, s - reach)
+         hi = min(hi, s + reach)
          a = max(sensor%patch_lo(k), lo)
          b = min(sensor%patch_hi(k), hi)
-         whole = hat_integral(lo, hi, s, h)
+         whole = hat_integral(lo, hi, s, reach)
          if (sensor%consistent) then
             weight = weight * sensor%along_value(k, s, h)
          else if (b <= a .or. whole <= 0.0_rp) then
             weight = 0.0_rp
          else
-            weight = weight * hat_integral(a, b, s, h) / whole
+            weight = weight * hat_integral(a, b, s, reach) / whole
          end if
       end do
    end subroutine patch_weight

@@ -141,6 +141,8 @@ def check_hydrostatic_2d(checks, flotsam, scenes, shape="linear"):
 # one across several: (name, lower y, upper y) [m]; h = 2 mm
 ROTATED_PANELS = [("band_1", 0.0, 0.002), ("band_2", 0.002, 0.006), ("band_3", 0.006, 0.016),
                   ("band_4", 0.016, 0.1), ("band_5", 0.1, 0.24)]
+# and panels of 1 and 4 cells at mid-depth (they overlap the bands: not part of the tiling)
+ROTATED_PROBES = [("mid_1", 0.1, 0.102), ("mid_4", 0.102, 0.11)]
 
 
 def check_hydrostatic_rotated(checks, flotsam, scenes):
@@ -150,7 +152,7 @@ def check_hydrostatic_rotated(checks, flotsam, scenes):
     template = flotsam.path("hydrostatic_rotated_panels_template.nml")
     with open(template, "w") as f:
         f.write(text + "".join(f"&panel name = '{n}', wall = 'x_min', lower = 0.0, {a}, upper = 0.0, {b} /\n"
-                               for n, a, b in ROTATED_PANELS))
+                               for n, a, b in ROTATED_PANELS + ROTATED_PROBES))
     H, W = 0.2, 0.32
     force, moment, weight = RHO * G * H ** 2 / 2, RHO * G * H ** 3 / 6, RHO * G * H * W
     settled = 0.1       # the start-up oscillation is left out (scene comment)
@@ -179,6 +181,10 @@ def check_hydrostatic_rotated(checks, flotsam, scenes):
         window_panels = panels[panels["time"] > settled * (1 + 1e-9)].mean()
         close(checks, window_panels["band_4_pressure"], RHO * G * (H - 0.058), 0.01,
               f"{label} panel band_4 (y 0.016 .. 0.1 m, 42 cells) mean pressure against rho g (H - y_c)")
+        for n, a, b in ROTATED_PROBES:
+            close(checks, window_panels[f"{n}_pressure"], RHO * G * (H - 0.5 * (a + b)), 0.02,
+                  f"{label} panel {n} (y {a} .. {b} m, {round((b - a) / 0.002)} cells) mean pressure against "
+                  "rho g (H - y_c)")
 
 
 # --- 3: hydrostatic 3-D -----------------------------------------------------------------------------------
