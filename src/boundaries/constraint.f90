@@ -99,6 +99,9 @@ module constraint
       procedure :: may_cut_support => always_may_cut
       !> narrow a sensor's wettable interval along grid axis `along` (a planar wall across it)
       procedure :: narrow_wet_interval => keep_interval
+      !> narrow the wettable interval along grid axis `along` of a sensor on this surface itself (a box
+      !> structure's face ends at its edges)
+      procedure :: narrow_own_interval => keep_interval
       !> narrow a sensor's wettable interval lo .. hi of s along the line point + s tangent (grid frame; a
       !> planar wall the line crosses)
       procedure :: narrow_along_line => keep_line_interval

@@ -272,6 +272,10 @@ contains
                         call self%items(v)%item%narrow_wet_interval(grid, along, sensor%point(1:dim), &
                                                                     sensor%wet_lo(along), sensor%wet_hi(along))
                      end do
+                     ! a panel on a box structure: its face ends at the box's edges
+                     if (sensor%kind == sensor_panel) &
+                        call c%narrow_own_interval(grid, along, sensor%point(1:dim), sensor%wet_lo(along), &
+                                                   sensor%wet_hi(along))
                   end do
                end if
                call sensor%set_patch(dim, grid%frame, grid%origin(1:dim), grid%h)

@@ -5,7 +5,7 @@ module structure_surface
    use kinds, only: rp
    use background_grid, only: grid_t
    use particle_set, only: particle_set_t
-   use shape_geometry, only: shape_t, shape_distance, shape_normal, shape_bounds, translated_shape
+   use shape_geometry, only: shape_t, shape_distance, shape_normal, shape_bounds, translated_shape, shape_box
    use surface_condition, only: surface_condition_t, friction_node
    use constraint, only: constraint_t, safeguard_pass_t, add_impulse, constraint_depth, on_surface_tolerance
    implicit none
@@ -26,6 +26,7 @@ module structure_surface
       procedure :: find_nodes => find_surface_nodes
       procedure :: put => put_shape
       procedure :: keep_out => keep_outside_structure
+      procedure :: narrow_own_interval => box_face_interval
    end type structure_surface_t
 
    public :: make_structure_surface
@@ -181,4 +182,19 @@ contains
          end do
       end associate
    end subroutine keep_outside_structure
+
+   !> A sensor on a face of a box whose faces are grid planes (not turned, on a grid that is not turned): the
+   !> face, and the part of the surface it can wet along grid axis `along`, ends at the box's edges.
+   subroutine box_face_interval(self, grid, along, point, wet_lo, wet_hi)
+      class(structure_surface_t), intent(in) :: self
+      type(grid_t), intent(in) :: grid
+      integer, intent(in) :: along
+      real(rp), intent(in) :: point(:)
+      real(rp), intent(inout) :: wet_lo, wet_hi
+      real(rp) :: lo(3), hi(3)
+      if (self%shape%kind /= shape_box .or. grid%frame%rotated .or. abs(self%shape%rotation) > 0.0_rp) return
+      call shape_bounds(self%shape, grid%dim, lo, hi)
+      wet_lo = max(wet_lo, lo(along))
+      wet_hi = min(wet_hi, hi(along))
+   end subroutine box_face_interval
 end module structure_surface

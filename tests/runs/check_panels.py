@@ -12,7 +12,9 @@ is held against the exact hydrostatic pressure and against loads.csv.
      every row the panels tiling a face add up to its load, the load cells to the sums (1e-10).
   4. A block sliding on a table (contact body fields): two load cells cutting the table add up to the
      table's load in every row, the body fields' part included.
-  5. panels.csv reads with one pandas call; its header names units, scene and program.
+  5. A submerged box structure (not turned): a panel per face, spanning it; the four add up to its load
+     in loads.csv in every row (1e-10): a face ends at the box's edges.
+  6. panels.csv reads with one pandas call; its header names units, scene and program.
 """
 import os
 
@@ -141,6 +143,20 @@ def check_contact(checks, flotsam, scenes):
                  f"(largest |table_left_fx| before 0.1 s: {early['table_left_fx'].abs().max():.4g} N/m)")
 
 
+def check_structure(checks, flotsam, scenes):
+    result = run(checks, flotsam, scenes, "pontoon.nml", 2, "panels_pontoon")
+    if result is None:
+        return
+    panels, loads = result
+    faces = ["top", "bottom", "left", "right"]
+    tiles(checks, panels, loads, faces, "pontoon", ["fy"], "structure")
+    # fx is zero by symmetry (1e-12 N/m): held against the vertical load
+    worst = (sum(panels[f"{p}_fx"] for p in faces) - loads["pontoon_fx"]).abs().max() / loads["pontoon_fy"].abs().max()
+    checks.check(worst <= TILING, f"structure: the faces' fx = pontoon fx in every row ({worst:.1e} of max |pontoon_fy|)")
+    checks.check((panels["bottom_pressure"] > panels["top_pressure"]).all(),
+                 "structure: the bottom face deeper, more pressure than the top in every row")
+
+
 def check_readable(checks, directory):
     path = os.path.join(directory, "panels.csv")
     frame = pd.read_csv(path, comment="#")
@@ -164,6 +180,7 @@ def main():
     check_3d(checks, flotsam, scenes)
     check_dam_break(checks, flotsam, scenes)
     check_contact(checks, flotsam, scenes)
+    check_structure(checks, flotsam, scenes)
     return checks.summary()
 
 
