@@ -29,6 +29,7 @@ pandas.read_csv(path, comment='#') reads them as well.
 """
 
 import argparse
+import functools
 import os
 import re
 import sys
@@ -127,9 +128,10 @@ def peak(times, values):
     return float(times[k]), float(values[k])
 
 
+@functools.lru_cache(maxsize=None)
 def signals_module(filtering=True):
-    """scripts/load_signals.py (beside this script, or in <prefix>/share/flotsam/python when installed).
-    With `filtering`: None if scipy is missing (the rows are then drawn alone)."""
+    """scripts/load_signals.py (beside this script, or in <prefix>/share/flotsam/python when installed),
+    found once. With `filtering`: None if scipy is missing (the rows are then drawn alone)."""
     here = os.path.dirname(os.path.realpath(__file__))
     for folder in (here, os.path.join(here, os.pardir, "share", "flotsam", "python")):
         if os.path.isfile(os.path.join(folder, "load_signals.py")):

@@ -80,6 +80,11 @@ module surface_sensors
       procedure :: along_value
    end type surface_sensor_t
 
+   !> The consistent weights of a panel along one tangent (set_patch).
+   type :: weight_column_t
+      real(rp), allocatable :: weights(:)
+   end type weight_column_t
+
    !> The sensors of one constraint and their taps on its current node list.
    type, public :: sensor_taps_t
       type(surface_sensor_t), allocatable :: sensors(:)
@@ -120,7 +125,7 @@ contains
       type(frame_t), intent(in) :: frame
       real(rp), intent(in), optional :: origin(:), h
       real(rp) :: tangents(dim, dim - 1), corner(dim), s, c
-      real(rp), allocatable :: weights(:)
+      type(weight_column_t) :: columns(2)
       logical :: axes
       integer :: k, along, m, j
       if (self%kind == sensor_load_cell) return
@@ -155,9 +160,14 @@ contains
       do k = 1, dim - 1
          along = maxloc(abs(tangents(:, k)), 1)
          call consistent_weights(self%wet_lo(along), self%wet_hi(along), self%patch_lo(k), self%patch_hi(k), &
-                                 origin(along), h, self%first_node(k), weights)
-         self%nodes_along(k) = size(weights)
-         call keep_column(self%along_weight, k, weights)
+                                 origin(along), h, self%first_node(k), columns(k)%weights)
+         self%nodes_along(k) = size(columns(k)%weights)
+      end do
+      if (allocated(self%along_weight)) deallocate (self%along_weight)
+      allocate (self%along_weight(maxval(self%nodes_along(1:dim - 1)), 2))
+      self%along_weight = 0.0_rp
+      do k = 1, dim - 1
+         self%along_weight(1:self%nodes_along(k), k) = columns(k)%weights
       end do
    end subroutine set_patch
 
@@ -220,23 +230,6 @@ contains
          weights(i) = (weights(i) - upper(i) * weights(i + 1)) / diagonal(i)
       end do
    end subroutine consistent_weights
-
-   !> Column k of `table` (node, k) set to `column`, the table grown to hold it.
-   pure subroutine keep_column(table, k, column)
-      real(rp), allocatable, intent(inout) :: table(:, :)
-      integer, intent(in) :: k
-      real(rp), intent(in) :: column(:)
-      real(rp), allocatable :: grown(:, :)
-      integer :: n
-      n = size(column)
-      if (allocated(table)) n = max(n, size(table, 1))
-      allocate (grown(n, 2))
-      grown = 0.0_rp
-      if (allocated(table)) grown(1:size(table, 1), :) = table
-      grown(:, k) = 0.0_rp
-      grown(1:size(column), k) = column
-      call move_alloc(grown, table)
-   end subroutine keep_column
 
    !> The consistent weight of a point at tangent coordinate s along tangent k: sum_j c_k(j) N_j(s) (at a
    !> node, its own c_k).
@@ -357,17 +350,20 @@ contains
             s = foot(along)
             lo = sensor%wet_lo(along)
             hi = sensor%wet_hi(along)
-            ! a panel's node beyond the wetted interval (behind the wall across it: a quadratic B-spline's
-            ! second layer) carries load of the face's end, and counts as a node at the end [R]
-            if (sensor%kind == sensor_panel) s = min(max(s, lo), hi)
          else
             s = dot_product(foot - sensor%point(1:dim), tangents(:, k))
             lo = sensor%tangent_lo(k)
             hi = sensor%tangent_hi(k)
-            if (sensor%kind == sensor_panel) s = min(max(s, lo), hi)
          end if
+         ! a panel's node beyond the wetted interval (behind the wall across it: a quadratic B-spline's
+         ! second layer) carries load of the face's end, and counts as a node at the end [R]
+         if (sensor%kind == sensor_panel) s = min(max(s, lo), hi)
          ! the patch cut to the wetted interval, and the part of it the node's hat covers
          area = area * max(0.0_rp, min(sensor%patch_hi(k), hi) - max(sensor%patch_lo(k), lo))
+         if (sensor%consistent) then
+            weight = weight * sensor%along_value(k, s, h)
+            cycle
+         end if
          reach = h
          if (.not. axes .and. sensor%kind == sensor_panel) reach = turned_reach_cells * h
          lo = max(lo, s - reach)
@@ -375,9 +371,7 @@ contains
          a = max(sensor%patch_lo(k), lo)
          b = min(sensor%patch_hi(k), hi)
          whole = hat_integral(lo, hi, s, reach)
-         if (sensor%consistent) then
-            weight = weight * sensor%along_value(k, s, h)
-         else if (b <= a .or. whole <= 0.0_rp) then
+         if (b <= a .or. whole <= 0.0_rp) then
             weight = 0.0_rp
          else
             weight = weight * hat_integral(a, b, s, reach) / whole
