@@ -3,7 +3,7 @@
 issue, one parameter at a time around the paper's hydrostatic tank (8 cells per 3.2 m, 3x3 particles
 per cell, grid turned by 45 degrees, 1 s), plus a block of another density in the floating-block scene.
 
-    scripts/stability_suite.py [--quick] [--contact-only] [--flotsam PATH] [--ranks N] [--out DIR]
+    scripts/stability_suite.py [--quick] [--contact-only] [--parameter LABEL] [--flotsam PATH] [--ranks N] [--out DIR]
 
 Every case must end in one of two acceptable ways:
   bounded    it reached its end time with the kinetic energy below the tank's potential energy
@@ -19,7 +19,9 @@ coefficient taken one at a time to their extremes. Bounded there means: the kine
 its initial value (walls and contact cannot add energy), no particle lost or behind a wall, the mass
 kept, and the disks' particles never closer than a quarter of the particle spacing (no interpenetration). Prints one line per case, writes <out>/stability.csv and
 <out>/stability.md (the table of docs/stability.md) and exits 1 if a case failed.
---quick runs the subset of the default test suite (a few seconds per case).
+--quick runs the subset of the default test suite (a few seconds per case); --parameter runs only the tank
+and block rows whose parameter label starts with LABEL (e.g. 'CFL'), no contact cases, to re-measure one
+row of the table after a change.
 """
 
 import argparse
@@ -214,6 +216,7 @@ def main():
     parser.add_argument("--schemes", default=",".join(SCHEMES),
                         help="comma-separated subset of " + ", ".join(SCHEMES))
     parser.add_argument("--contact-only", action="store_true", help="only the two-disk contact cases")
+    parser.add_argument("--parameter", help="only the rows whose parameter label starts with this (no contact)")
     args = parser.parse_args()
     schemes = [] if args.contact_only else args.schemes.split(",")
     unknown = [s for s in schemes if s not in SCHEMES]
@@ -226,6 +229,10 @@ def main():
     os.makedirs(out, exist_ok=True)
     rows, failures = [], 0
     cases = [] if args.contact_only else tank_cases(args.quick) + block_cases(args.quick)
+    if args.parameter:
+        cases = [case for case in cases if case[0].startswith(args.parameter)]
+        if not cases:
+            parser.error(f"no parameter label starts with {args.parameter!r}")
     for scheme in schemes:
         stabilization, _, correction = scheme.partition("+")
         material = f"&material name = 'water', stabilization = '{stabilization}'" + \
@@ -244,7 +251,7 @@ def main():
     disks = os.path.join(out, "two_disks.nml")
     with open(disks, "w") as f:
         f.write(DISKS)
-    for label, value, overrides in contact_cases(args.quick):
+    for label, value, overrides in ([] if args.parameter else contact_cases(args.quick)):
         folder = os.path.join(out, "cases", f"contact_{label.split()[0]}_{value}".replace("'", ""))
         code, stderr, seconds = run(args.flotsam, args.ranks, disks, overrides, folder)
         outcome, ok, detail = judge_disks(folder, code, stderr)

@@ -69,6 +69,9 @@ module mpm_solver
 
    !> Steps between full re-sorts of the particles when none arrived from another rank.
    integer, parameter :: sort_interval = 20
+   !> &run flip_fraction is the FLIP share of a step of the automatic length at this CFL number (the default
+   !> cfl; blend_per_step) [R]: the blend of every scene run at the default step is as it was.
+   real(rp), parameter :: blend_reference_cfl = 0.5_rp
 
    !> The stages of the step at which the components act (step_component), in the order the step reaches them.
    integer, parameter :: stage_before_walls_move = 1, stage_walls_placed = 2, stage_grid_summed = 3, &
@@ -100,6 +103,9 @@ module mpm_solver
       class(velocity_fields_t), allocatable :: fields
       type(rigid_set_t) :: rigid                !< the rigid bodies (&material model = 'rigid')
       real(rp) :: time = 0.0_rp, dt = 0.0_rp
+      !> the automatic step found with dt over the one at the FLIP/PIC blend's reference CFL number
+      !> (blend_reference_cfl); 1 with a fixed dt (blend_per_step)
+      real(rp) :: blend_exponent = 1.0_rp
       integer(i8) :: step = 0
       integer :: lost_particles = 0             !< local count of particles that left the grid
       integer :: wall_corrections = 0           !< local count of safeguard corrections
@@ -425,7 +431,8 @@ contains
                                   constraints=self%constraints, stencils=self%stencils, time=self%time, dt=dt, &
                                   step=self%step, loads=self%loads, rigid=self%rigid, timers=self%timers, &
                                   gravity=self%gravity, mass_tolerance=self%mass_tolerance, &
-                                  flip_fraction=self%run%flip_fraction, theta=self%run%theta)
+                                  flip_fraction=blend_per_step(self%run%flip_fraction, self%blend_exponent), &
+                                  theta=self%run%theta)
       call self%timers%switch_to(phase_walls)
       call self%constraints%set_activity(self%time)
       call run_stage(self, stage_before_walls_move, transfer%step_state_t)
@@ -719,7 +726,7 @@ contains
       speeds = -speeds
       call MPI_Allreduce(MPI_IN_PLACE, speeds, size(speeds), MPI_DOUBLE_PRECISION, MPI_MIN, self%domain%comm)
       call count_collective(comm_time_step, size(speeds), real_bytes)
-      call time_step_of_speeds(self, -speeds, wall_speed_ahead(self), dt, speed)
+      call time_step_of_speeds(self, -speeds, wall_speed_ahead(self), dt, speed, self%blend_exponent)
    end function solver_stable_time_step
 
    !> This rank's part of the step's bound, per material m: speeds(2 m - 1) the wave speed at the lowest
@@ -759,10 +766,10 @@ contains
    !> blowing-up state may have no valid one). An inlet that is not closed yet counts as a particle of its
    !> fluid at rho0 moving at v0 (a hydrograph: its largest speed until it closes): the step must resolve
    !> the fluid it is about to create (and an empty tank must not take a huge step).
-   subroutine time_step_of_speeds(self, speeds, wall_speed, dt, speed)
+   subroutine time_step_of_speeds(self, speeds, wall_speed, dt, speed, blend_exponent)
       type(solver_t), intent(in) :: self
       real(rp), intent(in) :: speeds(:), wall_speed
-      real(rp), intent(out) :: dt, speed
+      real(rp), intent(out) :: dt, speed, blend_exponent
       integer :: m, i
       speed = 0.0_rp
       do m = 1, size(self%materials)
@@ -782,14 +789,36 @@ contains
       end do
       if (self%run%fixed_dt > 0.0_rp) then
          dt = self%run%fixed_dt
+         blend_exponent = 1.0_rp
          return
       end if
-      dt = huge(1.0_rp)
-      if (speed > 0.0_rp) dt = self%run%cfl * self%grid%h / (sqrt(real(self%grid%dim, rp)) * speed)
-      ! a body without waves (rigid) at rest: falling from rest it moves g dt^2 / 2 <= cfl h in the step
-      if (any(self%gravity /= 0.0_rp)) dt = min(dt, sqrt(2.0_rp * self%run%cfl * self%grid%h / norm2(self%gravity)))
-      dt = min(dt, viscous_time_step(self))
+      dt = automatic_step(self, speed, self%run%cfl)
+      blend_exponent = 1.0_rp
+      if (self%run%cfl /= blend_reference_cfl) blend_exponent = dt / automatic_step(self, speed, blend_reference_cfl)
    end subroutine time_step_of_speeds
+
+   !> The step at CFL number cfl for the signal speed `speed`: cfl h / (sqrt(dim) speed), limited by the
+   !> fall from rest and the viscous step.
+   real(rp) function automatic_step(self, speed, cfl) result(dt)
+      type(solver_t), intent(in) :: self
+      real(rp), intent(in) :: speed, cfl
+      dt = huge(1.0_rp)
+      if (speed > 0.0_rp) dt = cfl * self%grid%h / (sqrt(real(self%grid%dim, rp)) * speed)
+      ! a body without waves (rigid) at rest: falling from rest it moves g dt^2 / 2 <= cfl h in the step
+      if (any(self%gravity /= 0.0_rp)) dt = min(dt, sqrt(2.0_rp * cfl * self%grid%h / norm2(self%gravity)))
+      dt = min(dt, viscous_time_step(self, cfl))
+   end function automatic_step
+
+   !> The FLIP share of a step, so that the PIC share damps at one rate per unit time: the blend alpha =
+   !> &run flip_fraction holds for a step of the automatic length at CFL number blend_reference_cfl, and an
+   !> automatic step `exponent` times as long keeps the deviation of the particles' velocities from the
+   !> grid's by alpha^exponent, as that many reference steps would (docs/theory.md, "The FLIP/PIC blend as a
+   !> rate"). At the default CFL number and with a fixed dt alpha itself, bit for bit.
+   pure real(rp) function blend_per_step(alpha, exponent) result(share)
+      real(rp), intent(in) :: alpha, exponent
+      share = alpha
+      if (exponent /= 1.0_rp .and. alpha > 0.0_rp .and. alpha < 1.0_rp) share = alpha**exponent
+   end function blend_per_step
 
    !> The next time step, and a new layout if the particles outgrew the active region or it became too big
    !> for them (active_region). One reduction for both: the step, the largest signal speed and the
@@ -832,7 +861,7 @@ contains
       call count_collective(comm_time_step, size(values), real_bytes)
       if (flags > 0) self%loop_flags = nint(-values(n + 1:))
       wall_speed = wall_speed_ahead(self)
-      call time_step_of_speeds(self, -values(7:n), wall_speed, self%dt, speed)
+      call time_step_of_speeds(self, -values(7:n), wall_speed, self%dt, speed, self%blend_exponent)
 
       ! a state that is no longer finite is the health check's business, not the layout's
       if (.not. all(ieee_is_finite(values(1:n)))) return
@@ -862,14 +891,15 @@ contains
    end function wall_speed_ahead
 
    !> CFL rho0 h^2 / (2 dim mu) over the viscous fluids present.
-   real(rp) function viscous_time_step(self) result(dt)
+   real(rp) function viscous_time_step(self, cfl) result(dt)
       type(solver_t), intent(in) :: self
+      real(rp), intent(in) :: cfl
       integer :: m
       dt = huge(1.0_rp)
       do m = 1, size(self%materials)
          select type (model => self%materials(m)%model)
          type is (newtonian_fluid_t)
-            if (model%viscosity > 0.0_rp) dt = min(dt, self%run%cfl * model%reference_density * self%grid%h**2 / &
+            if (model%viscosity > 0.0_rp) dt = min(dt, cfl * model%reference_density * self%grid%h**2 / &
                                                        (2.0_rp * self%grid%dim * model%viscosity))
          end select
       end do
