@@ -10,7 +10,7 @@ module scene_validation
    use kinds, only: rp, name_len
    use error_status, only: status_t
    use scene_description, only: scene_t, material_spec_t, contact_spec_t, structure_spec_t, model_newtonian_fluid
-   use input_text, only: quoted_list, group_context, ordinal
+   use input_text, only: quoted_list, group_context, ordinal, real_text
    use input_checks, only: check_real, pair_text
    use scene_memory, only: body_count, inlet_count
    use scene_defaults, only: find_structure, structure_name
@@ -42,6 +42,7 @@ contains
 
       call validate_run(scene%run, path, status)
       if (status%ok) call validate_grid(scene%grid, path, status)
+      if (status%ok) call check_courant_limit(scene, path, status)
       if (status%ok) call validate_box_walls(scene%grid, path, status)
       if (status%ok) call validate_gravity(scene%gravity, scene%grid%dim, path, status)
       if (.not. status%ok) return
@@ -190,4 +191,26 @@ contains
          call check_real(where, 'friction', contact%friction, status, at_least=0.0_rp)
       end associate
    end subroutine validate_contact
+
+   !> The automatic step's CFL number must not exceed the critical step of the grid's shape functions
+   !> (docs/theory.md section 5.1, scripts/critical_step.py): dt_crit = h / c for multilinear functions in
+   !> every dimension, 1.54 h / c for quadratic B-splines (the smallest over the quadratures), so cfl at most
+   !> sqrt(dim) and 1.54 sqrt(dim) with dt = cfl h / (sqrt(dim) c) [D]. A fixed dt has its own guard (the
+   !> run stops when it exceeds the CFL step).
+   subroutine check_courant_limit(scene, path, status)
+      type(scene_t), intent(in) :: scene
+      character(len=*), intent(in) :: path
+      type(status_t), intent(inout) :: status
+      real(rp), parameter :: bspline2_critical_step = 1.54_rp   ! [h / c]
+      real(rp) :: limit
+      character(len=8) :: limit_text
+      limit = sqrt(real(scene%grid%dim, rp))
+      if (scene%grid%shape_function == 'bspline2') limit = bspline2_critical_step * limit
+      if (scene%run%cfl <= limit * (1.0_rp + 1.0e-12_rp)) return
+      write (limit_text, '(f8.2)') limit
+      call status%fail(trim(path)//': group &run: variable cfl = '//real_text(scene%run%cfl)//' exceeds the critical '// &
+                       'step of '//trim(scene%grid%shape_function)//' shape functions in '// &
+                       achar(iachar('0') + scene%grid%dim)//'-D (at most '//trim(adjustl(limit_text))// &
+                       '; docs/theory.md section 5.1)')
+   end subroutine check_courant_limit
 end module scene_validation

@@ -266,7 +266,9 @@ contains
 
       where = group_context(path, 'run', 0)
       call check_real(where, 'end_time', run%end_time, status, greater_than=0.0_rp)
-      call check_real(where, 'cfl', run%cfl, status, greater_than=0.0_rp, at_most=1.0_rp)
+      ! at most the largest critical step of any shape function (bspline2 in 3-D: 2.67); the grid's own limit
+      ! is checked with the grid (scene_validation)
+      call check_real(where, 'cfl', run%cfl, status, greater_than=0.0_rp, at_most=3.0_rp)
       call check_real(where, 'dt', run%fixed_dt, status, at_least=0.0_rp)
       call check_real(where, 'output_interval', run%output_interval, status, at_least=0.0_rp)
       if (len_trim(run%output_dir) == 0) call status%fail(where//': variable output_dir must not be empty')
