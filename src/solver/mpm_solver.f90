@@ -444,6 +444,7 @@ contains
       context%grid => self%grid
       context%stencils => self%stencils
       context%dt = dt
+      context%reference_steps = self%blend_exponent
       ! the rate's nodal velocities (MUSL; rows 1:dim: with contact fields the common field's)
       context%strain_velocity => self%fields%strain_velocity()
       ! a scheme of a material no body or opened inlet supplies has no particles on any rank: skip it (its

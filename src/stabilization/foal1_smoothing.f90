@@ -130,6 +130,9 @@ contains
 
          ! (d) limited face fluxes
          call field_flux_increments(self%box, context%grid%h, exists, field, self%options, dq, self%workspace)
+         ! a step shorter than the reference takes that part of the fluxes (they smooth again at every
+         ! step; a part of a limited increment stays within the limits); a longer step takes them whole
+         if (context%reference_steps < 1.0_rp) dq = context%reference_steps * dq
 
          ! (e) particle update
          if (self%pressure_only) then

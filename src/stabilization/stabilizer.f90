@@ -21,6 +21,10 @@ module stabilizer
       type(domain_t), pointer :: domain => null()
       type(grid_t), pointer :: grid => null()
       real(rp) :: dt = 0.0_rp
+      !> the step's length in steps of the automatic length at the reference CFL number (1 at the default
+      !> step and with a fixed dt; mpm_solver's blend_per_step): a smoothing that acts once per step scales
+      !> its change by it, so that it acts at one rate per unit time
+      real(rp) :: reference_steps = 1.0_rp
       !> the material is the only one with particles, on every rank: the grid's mass row of the step's P2G
       !> is its nodal mass (NB uses it)
       logical :: sole_material = .false.
