@@ -123,9 +123,10 @@ contains
    !> (< 0: its condition), and field_impulse(:, w, f) gains the part of impulse(:, w) given to field f's
    !> particles. Columns of `impulse` after the constraints' are the sensors' (surface_sensors: panels and
    !> load cells gain their part of the safeguard's impulse). The particles of a material with
-   !> `skip(material)` are left alone: rigid bodies meet the walls as bodies (rigid_bodies). lowest(1:dim), highest(1:dim): bounds on the particles' coordinates
-   !> (the step's extent, which G2P takes as it moves them; wider is fine). They only let a pass be skipped
-   !> when no particle can be behind a constraint; a pass of their own over the particles was 3 % of a 2-D step.
+   !> `skip(material)` are left alone: rigid bodies meet the walls as bodies (rigid_bodies). lowest(1:dim),
+   !> highest(1:dim): bounds on the particles' coordinates (the step's extent, which G2P takes as it moves
+   !> them; wider is fine). They only let a pass be skipped when no particle can be behind a constraint; a
+   !> pass of their own over the particles was 3 % of a 2-D step.
    subroutine keep_particles_inside(self, grid, particles, lowest, highest, corrections, impulse, field, &
                                     field_friction, field_impulse, skip)
       class(constraint_list_t), intent(in) :: self
