@@ -16,7 +16,7 @@ module scene_validation
    use scene_defaults, only: find_structure, structure_name
    use material_group, only: find_material, validate_material, check_shape_function_combination
    use run_group, only: validate_run
-   use grid_group, only: validate_grid, validate_box_walls
+   use grid_group, only: validate_grid, validate_box_walls, critical_courant_number
    use gravity_group, only: validate_gravity
    use inlet_group, only: validate_inlet
    use body_validation, only: validate_body, check_body_has_particles
@@ -193,19 +193,15 @@ contains
    end subroutine validate_contact
 
    !> The automatic step's CFL number must not exceed the critical step of the grid's shape functions
-   !> (docs/theory.md section 5.1, scripts/critical_step.py): dt_crit = h / c for multilinear functions in
-   !> every dimension, 1.54 h / c for quadratic B-splines (the smallest over the quadratures), so cfl at most
-   !> sqrt(dim) and 1.54 sqrt(dim) with dt = cfl h / (sqrt(dim) c) [D]. A fixed dt has its own guard (the
-   !> run stops when it exceeds the CFL step).
+   !> (critical_courant_number). A fixed dt has its own guard (the run stops when it exceeds the CFL step);
+   !> cfl = 0 (the default fraction of the limit) is resolved later.
    subroutine check_courant_limit(scene, path, status)
       type(scene_t), intent(in) :: scene
       character(len=*), intent(in) :: path
       type(status_t), intent(inout) :: status
-      real(rp), parameter :: bspline2_critical_step = 1.54_rp   ! [h / c]
       real(rp) :: limit
       character(len=8) :: limit_text
-      limit = sqrt(real(scene%grid%dim, rp))
-      if (scene%grid%shape_function == 'bspline2') limit = bspline2_critical_step * limit
+      limit = critical_courant_number(scene%grid)
       if (scene%run%cfl <= limit * (1.0_rp + 1.0e-12_rp)) return
       write (limit_text, '(f8.2)') limit
       call status%fail(trim(path)//': group &run: variable cfl = '//real_text(scene%run%cfl)//' exceeds the critical '// &

@@ -56,7 +56,7 @@ module checkpoint
 
    !> What a checkpoint holds for this rank, read in full before any of it is adopted.
    type :: saved_state_t
-      real(rp) :: time = 0.0_rp, dt = 0.0_rp, blend_exponent = 1.0_rp, mass_tolerance = 0.0_rp, next_output_time = 0.0_rp
+      real(rp) :: time = 0.0_rp, dt = 0.0_rp, reference_steps = 1.0_rp, mass_tolerance = 0.0_rp, next_output_time = 0.0_rp
       integer(i8) :: step = 0
       integer(i8) :: total = 0                    !< particles written
       integer(i8) :: unimproved_largest = 0       !< solver%unimproved_largest (same decomposition only)
@@ -107,7 +107,7 @@ contains
       call file%write_attribute('time', solver%time, status)
       call file%write_attribute('step', solver%step, status)
       call file%write_attribute('dt', solver%dt, status)
-      call file%write_attribute('blend_exponent', solver%blend_exponent, status)
+      call file%write_attribute('reference_steps', solver%reference_steps, status)
       call file%write_attribute('mass_tolerance', solver%mass_tolerance, status)
       call file%write_attribute('next_output_time', progress%next_output_time, status)
       call file%write_attribute('unimproved_largest', solver%unimproved_largest, status)
@@ -334,9 +334,14 @@ contains
       call file%read_attribute('time', state%time, status)
       call file%read_attribute('step', state%step, status)
       call file%read_attribute('dt', state%dt, status)
-      ! the FLIP/PIC blend's exponent (absent in files of before 2026-12-03: 1, the blend per step)
-      state%blend_exponent = 1.0_rp
-      if (file%has_attribute('blend_exponent')) call file%read_attribute('blend_exponent', state%blend_exponent, status)
+      ! the step in steps of the blend's reference CFL number (files of 2026-12-03 name it blend_exponent;
+      ! absent in older files: 1, the blend per step)
+      state%reference_steps = 1.0_rp
+      if (file%has_attribute('reference_steps')) then
+         call file%read_attribute('reference_steps', state%reference_steps, status)
+      else if (file%has_attribute('blend_exponent')) then
+         call file%read_attribute('blend_exponent', state%reference_steps, status)
+      end if
       call file%read_attribute('mass_tolerance', state%mass_tolerance, status)
       call file%read_attribute('next_output_time', state%next_output_time, status)
       ! the load balancing's memory of a fruitless layout search (absent in files of before 2026-11-27: none)
@@ -439,7 +444,7 @@ contains
       solver%time = state%time
       solver%step = state%step
       solver%dt = state%dt
-      solver%blend_exponent = state%blend_exponent
+      solver%reference_steps = state%reference_steps
       solver%mass_tolerance = state%mass_tolerance
       if (state%same_decomposition) then
          solver%unimproved_largest = state%unimproved_largest

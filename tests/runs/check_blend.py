@@ -3,8 +3,9 @@
 3-D dam break of tests/runs/scenes/blend/dam_break_3d.nml at CFL 0.25, 0.5 and 1.0 on 2 ranks.
 
   1. the kinetic energy at 0.2 s (diagnostics.csv) and the front's advance (the farthest particle's x
-     less the column's 1 m, from the last fields file) of the three runs within 3 % of each other's
-     median (with the blend per step they spread over 41 % and 24 % of it: the scene says the numbers);
+     less the column's 1 m, from the last fields file) of the three runs within 1 % and 3 % of each
+     other's median (issue 53 asks 3 % of both; measured 0.35 % and 1.3 % with the PIC share linear in the
+     step, 1.5 % and 2.0 % with alpha**a, 41 % and 24 % with the blend per step: the scene says them);
   2. the step count halves with each doubling of the CFL number (the runs are what they say);
   3. a restart at CFL 1.0 (the blend's exponent 2 is in the checkpoint) gives diagnostics.csv byte for
      byte the uninterrupted run's;
@@ -22,7 +23,7 @@ import pandas as pd
 from flotsam_run import Checks, Flotsam, main_arguments
 
 COLUMN = 1.0        # the column's length [m]: the front starts there
-TOLERANCE = 0.03
+TOLERANCE = {"energy": 0.01, "advance": 0.03}
 
 
 def measure(folder):
@@ -60,8 +61,8 @@ def main():
         for key, what in (("energy", "kinetic energy at 0.2 s [J]"), ("advance", "front's advance at 0.2 s [m]")):
             values = [found[c][key] for c in ("0.25", "0.5", "1.0")]
             spread = (max(values) - min(values)) / np.median(values)
-            checks.check(spread <= TOLERANCE, f"{what} at CFL 0.25, 0.5, 1.0: {', '.join(f'{v:.4g}' for v in values)}, "
-                         f"within {spread:.1%} of the median (tolerance {TOLERANCE:.0%})")
+            checks.check(spread <= TOLERANCE[key], f"{what} at CFL 0.25, 0.5, 1.0: {', '.join(f'{v:.4g}' for v in values)}, "
+                         f"within {spread:.1%} of the median (tolerance {TOLERANCE[key]:.0%})")
     # a restart where the blend's exponent is not 1: stopped at step 150, continued from its step-100 checkpoint
     whole = flotsam.path("cfl_1.0", "diagnostics.csv")
     name = "cfl_1.0_split"
@@ -75,8 +76,8 @@ def main():
             with h5py.File(candidate) as f:
                 if int(f.attrs["step"]) == 100:
                     checkpoint = os.path.relpath(candidate, flotsam.workdir)
-                    checks.check(float(f.attrs["blend_exponent"]) > 1.9,
-                                 f"restart: the checkpoint holds the blend's exponent ({float(f.attrs['blend_exponent']):.4f})")
+                    steps = float(f.attrs["reference_steps"])
+                    checks.check(steps > 1.9, f"restart: the checkpoint holds the step in reference steps ({steps:.4f})")
         if checks.check(checkpoint is not None, "restart: a checkpoint at step 100"):
             path = flotsam.scene(template, name + "_continue.nml", name, cfl="1.0")
             result = flotsam.run(path, 2, "--restart", checkpoint)

@@ -14,7 +14,7 @@ module grid_group
    private
 
    public :: validate_grid, validate_box_walls, side_name, read_grid_group, grid_value, read_box_walls_group, &
-             box_walls_value
+             box_walls_value, critical_courant_number
 
    !> Wall condition keywords of the box sides (`&box_walls`).
    character(len=*), parameter, public :: wall_none = 'none'
@@ -304,4 +304,15 @@ contains
       character(len=5) :: name
       name = axis_letter(axis)//merge('_min', '_max', side == 1)
    end function side_name
+
+   !> The CFL number of the automatic step dt = cfl h / (sqrt(dim) c) at the critical step of the grid's
+   !> shape functions (docs/theory.md section 5.1, scripts/critical_step.py) [D]: dt_crit = h / c for
+   !> multilinear functions in every dimension, 1.54 h / c for quadratic B-splines (the smallest over the
+   !> quadratures), so sqrt(dim) and 1.54 sqrt(dim).
+   pure real(rp) function critical_courant_number(grid) result(cfl)
+      type(grid_spec_t), intent(in) :: grid
+      real(rp), parameter :: bspline2_critical_step = 1.54_rp   ! [h / c]
+      cfl = sqrt(real(grid%dim, rp))
+      if (grid%shape_function == 'bspline2') cfl = bspline2_critical_step * cfl
+   end function critical_courant_number
 end module grid_group

@@ -27,7 +27,9 @@ module run_group
    !> `&run`: time stepping, update scheme and output control.
    type, public :: run_control_t
       real(rp) :: end_time = -1.0_rp          !< simulated time to reach [s] (required)
-      real(rp) :: cfl = 0.5_rp                !< Courant number of the automatic time step
+      !> Courant number of the automatic time step; 0: the default of each material (the solver's
+      !> material_courant_numbers: a fluid on multilinear functions 0.75 sqrt(dim), else 0.5)
+      real(rp) :: cfl = 0.0_rp
       real(rp) :: fixed_dt = 0.0_rp           !< fixed time step [s]; 0 selects the CFL step
       real(rp) :: output_interval = 0.0_rp    !< simulated time between diagnostics rows [s]; 0: end_time/100
       character(len=path_len) :: output_dir = 'output'
@@ -267,8 +269,8 @@ contains
       where = group_context(path, 'run', 0)
       call check_real(where, 'end_time', run%end_time, status, greater_than=0.0_rp)
       ! at most the largest critical step of any shape function (bspline2 in 3-D: 2.67); the grid's own limit
-      ! is checked with the grid (scene_validation)
-      call check_real(where, 'cfl', run%cfl, status, greater_than=0.0_rp, at_most=3.0_rp)
+      ! is checked with the grid (scene_validation); 0 (not given) is the default of each material
+      if (run%cfl /= 0.0_rp) call check_real(where, 'cfl', run%cfl, status, greater_than=0.0_rp, at_most=3.0_rp)
       call check_real(where, 'dt', run%fixed_dt, status, at_least=0.0_rp)
       call check_real(where, 'output_interval', run%output_interval, status, at_least=0.0_rp)
       if (len_trim(run%output_dir) == 0) call status%fail(where//': variable output_dir must not be empty')
