@@ -76,8 +76,8 @@ contains
       scene = water_scene(3, 0.1_rp, [4.0_rp, 4.0_rp, 4.0_rp], 2.0e6_rp, 0.0_rp)
       call add_body(scene, 1, [0.5_rp, 0.5_rp, 2.5_rp], [0.9_rp, 0.9_rp, 2.9_rp], 2, .false., 0.0_rp)
       scene%bodies(1)%velocity = [4.0_rp, 3.0_rp, -2.0_rp]
-      ! the bound counts the guard of a step at CFL 0.5 (at the fluid's default, 1.30, the guard is one cell
-      ! wider: 0.107 of the grid)
+      ! the bound counts the guard of a step at CFL 0.5 (at CFL 1.30 the guard is one cell wider: 0.107 of
+      ! the grid)
       scene%run%cfl = 0.5_rp
       call check_travelling_block(comm, scene, 0.5_rp, 3, 0.1_rp)
    end subroutine test_travelling_block_3d_is_followed
