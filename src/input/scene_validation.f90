@@ -194,7 +194,7 @@ contains
 
    !> The automatic step's CFL number must not exceed the critical step of the grid's shape functions
    !> (critical_courant_number). A fixed dt has its own guard (the run stops when it exceeds the CFL step);
-   !> cfl = 0 (the default fraction of the limit) is resolved later.
+   !> cfl = 0 (each material's default, the solver's material_courant_numbers) is below every limit.
    subroutine check_courant_limit(scene, path, status)
       type(scene_t), intent(in) :: scene
       character(len=*), intent(in) :: path

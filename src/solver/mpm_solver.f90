@@ -788,12 +788,6 @@ contains
       real(rp), intent(out) :: dt, speed, reference_steps
       integer :: m, i
       real(rp) :: material_speed(size(self%materials)), created
-      do m = 1, size(self%materials)
-         material_speed(m) = speeds(2 * m - 1) + speeds(2 * m)
-         ! a moving wall counts as a particle of every material moving at its speed (it drives the material
-         ! next to it at that speed); none: speed unchanged, bit for bit
-         if (wall_speed > 0.0_rp) material_speed(m) = max(material_speed(m), speeds(2 * m - 1) + wall_speed)
-      end do
       ! the particles a component is about to create (an open inlet's fluid), at the smallest CFL number
       created = 0.0_rp
       do i = 1, size(self%components)
@@ -802,6 +796,10 @@ contains
       end do
       speed = created
       do m = 1, size(self%materials)
+         material_speed(m) = speeds(2 * m - 1) + speeds(2 * m)
+         ! a moving wall counts as a particle of every material moving at its speed (it drives the material
+         ! next to it at that speed); none: speed unchanged, bit for bit
+         if (wall_speed > 0.0_rp) material_speed(m) = max(material_speed(m), speeds(2 * m - 1) + wall_speed)
          speed = max(speed, material_speed(m))
       end do
       if (self%run%fixed_dt > 0.0_rp) then
@@ -853,15 +851,16 @@ contains
 
    !> The FLIP share of a step, so that the PIC share damps at one rate per unit time: the blend alpha =
    !> &run flip_fraction holds for a step of the automatic length at CFL number blend_reference_cfl, and an
-   !> automatic step `exponent` times as long takes `exponent` times its PIC share 1 - alpha (at most all of
-   !> it). Linear, not alpha**exponent: the deviation of the particles' velocities from the grid's that the
-   !> PIC share removes is made anew by every transfer, so the energy it takes per unit time is the share
-   !> per step over the step (docs/theory.md, "The FLIP/PIC blend as a rate"). At the default CFL number
-   !> and with a fixed dt alpha itself, bit for bit.
-   pure real(rp) function blend_per_step(alpha, exponent) result(share)
-      real(rp), intent(in) :: alpha, exponent
+   !> automatic step `reference_steps` times as long takes that many times its PIC share 1 - alpha (at most
+   !> all of it). Linear, not alpha**reference_steps: the deviation of the particles' velocities from the
+   !> grid's that the PIC share removes is made anew by every transfer, so the energy it takes per unit time
+   !> is the share per step over the step (docs/theory.md, "The FLIP/PIC blend as a rate"). At the default
+   !> CFL number and with a fixed dt alpha itself, bit for bit.
+   pure real(rp) function blend_per_step(alpha, reference_steps) result(share)
+      real(rp), intent(in) :: alpha, reference_steps
       share = alpha
-      if (exponent /= 1.0_rp .and. alpha > 0.0_rp .and. alpha < 1.0_rp) share = max(0.0_rp, 1.0_rp - (1.0_rp - alpha) * exponent)
+      if (reference_steps /= 1.0_rp .and. alpha > 0.0_rp .and. alpha < 1.0_rp) &
+         share = max(0.0_rp, 1.0_rp - (1.0_rp - alpha) * reference_steps)
    end function blend_per_step
 
    !> The next time step, and a new layout if the particles outgrew the active region or it became too big

@@ -7,7 +7,7 @@
      other's median (issue 53 asks 3 % of both; measured 0.35 % and 1.3 % with the PIC share linear in the
      step, 1.5 % and 2.0 % with alpha**a, 41 % and 24 % with the blend per step: the scene says them);
   2. the step count halves with each doubling of the CFL number (the runs are what they say);
-  3. a restart at CFL 1.0 (the blend's exponent 2 is in the checkpoint) gives diagnostics.csv byte for
+  3. a restart at CFL 1.0 (its step of 2 reference steps is in the checkpoint) gives diagnostics.csv byte for
      byte the uninterrupted run's;
   4. NB's stress projection acts at one rate too: the paper's tank at rest (inputs/hydrostatic_tank.nml,
      NB, pure FLIP, CFL 0.05, 0.4 s) keeps its kinetic energy below 1 J (with the whole projection in
@@ -63,7 +63,7 @@ def main():
             spread = (max(values) - min(values)) / np.median(values)
             checks.check(spread <= TOLERANCE[key], f"{what} at CFL 0.25, 0.5, 1.0: {', '.join(f'{v:.4g}' for v in values)}, "
                          f"within {spread:.1%} of the median (tolerance {TOLERANCE[key]:.0%})")
-    # a restart where the blend's exponent is not 1: stopped at step 150, continued from its step-100 checkpoint
+    # a restart where the step is not one reference step: stopped at step 150, continued from its step-100 checkpoint
     whole = flotsam.path("cfl_1.0", "diagnostics.csv")
     name = "cfl_1.0_split"
     flotsam.remove(name)
