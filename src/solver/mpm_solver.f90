@@ -72,18 +72,20 @@ module mpm_solver
    !> &run flip_fraction is the FLIP share of a step of the automatic length at this CFL number (the default
    !> cfl; blend_per_step) [R]: the blend of every scene run at the default step is as it was.
    real(rp), parameter :: blend_reference_cfl = 0.5_rp
-   !> The default automatic step (&run cfl = 0) per material [R] (docs/theory.md section 5.1): CFL 0.5 for
-   !> every material, a third of the multilinear critical step in 2-D. A weakly compressible fluid on
-   !> multilinear functions runs stable and as accurate in its flow at 0.75 h / c (CFL 1.30 in 3-D: the
-   !> bench dam break's kinetic energy 0.57 % from half that step, 2.6 times fewer steps), but three
-   !> validation claims fail there and are not understood yet: a sheet turning up a wall (the pressure 15 mm
-   !> up -11.9 %, tolerance 10 %), the floating block's draft (-3.7 %, tolerance 2 %) and NB's cure of the
-   !> filling tank's locking ([Y17] Fig. 1). A solid's waves carry the loads of an impact, whose front
-   !> overshoots more at larger steps (an elastic block on a wall: the peak +4..6 % of rho c_P A v at CFL
-   !> 0.5, +6..13 % at 1.06), a rigid body's rotation is explicit, and with quadratic B-splines a tank's
-   !> start-up transient stays in its loads longer (the 3-D hydrostatic floor force over 0.02 s: -0.44 % at
-   !> 0.5, -0.6 % at 1.0 and 1.30).
-   real(rp), parameter :: fluid_default_cfl = 0.5_rp, other_default_cfl = 0.5_rp
+   !> The default automatic step (&run cfl = 0) per material [R] (docs/theory.md section 5.1). A weakly
+   !> compressible fluid on multilinear functions steps at 0.75 h / c (CFL 1.06 in 2-D, 1.30 in 3-D; the
+   !> bench dam break's kinetic energy 0.57 % from half that step in 2.6 times fewer steps): its sound speed
+   !> is chosen for the step, and the smoothing of FOAL1 and NB, in passes per reference step
+   !> (smoothing_passes), keeps its rate per unit time. Everything else at CFL 0.5: a fluid with C0, whose
+   !> cell averages leave a checkerboard pressure that grows at long steps (the filling tank at 3 s, [Y17]
+   !> Fig. 1: RMS 0.31 / 0.30 / 0.56 rho g 1 m at CFL 0.5 / 0.75 / 1.06), a solid, whose waves carry the
+   !> loads of an impact and whose front overshoots more at larger steps (an elastic block on a wall: the
+   !> peak +4..6 % of rho c_P A v at 0.5, +6..13 % at 1.06), a rigid body, whose rotation is explicit, and
+   !> quadratic B-splines, with which a tank's start-up transient stays in its loads longer (the 3-D
+   !> hydrostatic floor force over 0.02 s: -0.44 % at 0.5, -0.6 % at 1.0 and 1.30).
+   real(rp), parameter :: other_default_cfl = 0.5_rp
+   !> a fluid's default step as a fraction of h / c (its CFL number is this times sqrt(dim))
+   real(rp), parameter :: fluid_default_step = 0.75_rp
 
    !> The stages of the step at which the components act (step_component), in the order the step reaches them.
    integer, parameter :: stage_before_walls_move = 1, stage_walls_placed = 2, stage_grid_summed = 3, &
@@ -199,7 +201,8 @@ contains
       call self%loads%init(scene)
       call build_boundaries(self)
       ! inlet ids start after every id of the bodies (their whole lattices, not just the particles kept)
-      call build_step_components(self%scene, scene_id_count(self%scene), self%gravity, self%constraints, &
+      call build_step_components(self%scene, scene_id_count(self%scene), self%gravity, &
+                                 maxval(self%courant) / blend_reference_cfl, self%constraints, &
                                  self%components)
       call check_sensors_on_surfaces(self%scene, self%grid%h, self%sensor_offset, self%sensor_outside, status)
       if (.not. status%ok) return
@@ -444,7 +447,8 @@ contains
       ! the step's state: what the components' stages read (its parent) and what the transfers read
       transfer = transfer_state_t(domain=self%domain, grid=self%grid, particles=self%particles, &
                                   constraints=self%constraints, stencils=self%stencils, time=self%time, dt=dt, &
-                                  step=self%step, loads=self%loads, rigid=self%rigid, timers=self%timers, &
+                                  reference_steps=self%reference_steps, step=self%step, loads=self%loads, &
+                                  rigid=self%rigid, timers=self%timers, &
                                   gravity=self%gravity, mass_tolerance=self%mass_tolerance, &
                                   flip_fraction=blend_per_step(self%run%flip_fraction, self%reference_steps), &
                                   theta=self%run%theta)
@@ -819,8 +823,8 @@ contains
    end subroutine time_step_of_speeds
 
    !> Per material of the scene, the CFL number of its automatic step: &run cfl when the scene gives it (one
-   !> number for all), else the material's default (fluid_default_cfl for a fluid on multilinear functions,
-   !> else other_default_cfl).
+   !> number for all), else the material's default (fluid_default_step h / c for a fluid on multilinear
+   !> functions but with C0, else other_default_cfl).
    pure function material_courant_numbers(scene) result(courant)
       type(scene_t), intent(in) :: scene
       real(rp), allocatable :: courant(:)
@@ -829,8 +833,9 @@ contains
       do m = 1, size(scene%materials)
          if (scene%run%cfl > 0.0_rp) then
             courant(m) = scene%run%cfl
-         else if (scene%materials(m)%model == model_newtonian_fluid .and. scene%grid%shape_function == 'linear') then
-            courant(m) = fluid_default_cfl
+         else if (scene%materials(m)%model == model_newtonian_fluid .and. scene%grid%shape_function == 'linear' .and. &
+                  scene%materials(m)%stabilization /= 'C0') then
+            courant(m) = fluid_default_step * sqrt(real(scene%grid%dim, rp))
          else
             courant(m) = other_default_cfl
          end if

@@ -37,6 +37,9 @@ module step_component
       type(stencil_cache_t), pointer :: stencils => null()     !< P2G's stencils at x^n (3-D)
       real(rp) :: time = 0.0_rp                 !< t_n [s]
       real(rp) :: dt = 0.0_rp                   !< the step runs to t_n + dt
+      !> dt in automatic steps at the reference CFL number (stage_context_t's): a correction made per step
+      !> acts at one rate per unit time with it
+      real(rp) :: reference_steps = 1.0_rp
       integer(i8) :: step = 0                   !< n
    end type step_state_t
 

@@ -17,11 +17,12 @@ module step_component_factory
 contains
 
    !> `first_id`: the first particle id after the bodies' (the inlets' ids follow); `gravity` in the grid
-   !> frame; `constraints` built from the same scene (the inlets' feeders are constraints).
-   subroutine build_step_components(scene, first_id, gravity, constraints, components)
+   !> frame; `constraints` built from the same scene (the inlets' feeders are constraints);
+   !> `planned_reference_steps` the longest step the scene's CFL numbers allow, in reference steps.
+   subroutine build_step_components(scene, first_id, gravity, planned_reference_steps, constraints, components)
       type(scene_t), intent(in) :: scene
       integer(i8), intent(in) :: first_id
-      real(rp), intent(in) :: gravity(3)
+      real(rp), intent(in) :: gravity(3), planned_reference_steps
       type(constraint_list_t), intent(in) :: constraints
       type(component_slot_t), allocatable, intent(out) :: components(:)
       type(inflow_t), allocatable :: inflow
@@ -37,7 +38,7 @@ contains
          end if
       end if
       allocate (volume)
-      call volume%init(scene, gravity)
+      call volume%init(scene, gravity, planned_reference_steps)
       if (volume%shifting .or. volume%relaxing) then
          volume%phase = phase_volume_correction
          call append(components, volume)

@@ -11,8 +11,10 @@
 !>                   (inside the walls and the grid), is 1 where particles fill space as their volumes say
 !>                   and > 1 where they crowd. Particles move down the gradient of the excess
 !>                     psi_i = max(phi_i - 1, 0),   dx_p = -D h^2 sum_i grad N_i(x_p) psi_i
-!>                   (D = shifting_coefficient per step; applied every k steps with k D, k = 0.2 / D,
-!>                   so that its cost is a k-th, at most 0.1 h per application). One-sided: a node that is not
+!>                   (D = shifting_coefficient per reference step, the automatic step at CFL 0.5; applied
+!>                   every k steps with k D a for a step of a reference steps, k = 0.2 / (D a_max) for the
+!>                   longest step the scene allows, so that its cost is a k-th; at most 0.1 h and D k a =
+!>                   0.25 per application). One-sided: a node that is not
 !>                   full (free surface, walls, spray) never pulls particles, so surfaces do not spread.
 !>                   Mass, momentum and stress of each particle are kept.
 !>                   Under gravity, V_i also leaves out the space above the free surface: a height function
@@ -24,7 +26,8 @@
 !>                   and FOAL1 lets single particles' J wander (to 2.9 rho_0 in the floating block by 30 s,
 !>                   10^7 rho_0 with the surface shifting), and phi weighs particles by their volume.
 !>   eos_relaxation  pull the pressure back toward the equation of state p_EOS = K ln(rho/rho_0) after the
-!>                   smoothing, p := p + r (p_EOS - p) (r = eos_relaxation_rate per step): smoothing may
+!>                   smoothing, p := p + r (p_EOS - p) (r = eos_relaxation_rate per reference step; a step
+!>                   of a reference steps removes 1 - (1 - r)^a): smoothing may
 !>                   then no longer drain the pressure. Seeding and inflow start such fluids at
 !>                   rho = rho_0 exp(p/K), so that the hydrostatic state is an EOS state.
 !>
@@ -64,6 +67,8 @@ module volume_correction
    !> The shifting runs every k steps with k D per application, k the largest with k D <= this: the
    !> crowding builds over thousands of steps, so a k-th of the cost buys the same correction.
    real(rp), parameter :: coefficient_per_application = 0.2_rp
+   !> Above this D k per application the explicit diffusion of the shifting is unstable (docs/input.md).
+   real(rp), parameter :: stable_coefficient_per_application = 0.25_rp
    !> Largest shift per application, in cells (the particles' extent widens by it: particles_moved).
    real(rp), parameter :: max_shift_in_cells = 0.1_rp
    !> Horizontal bins of the height function per cell width (2-D, 3-D): finer than a particle at 3 per cell,
@@ -85,6 +90,7 @@ module volume_correction
       logical :: shifting = .false.                 !< some material shifts
       logical :: relaxing = .false.                 !< some material relaxes its pressure to the EOS
       integer :: interval = 1                       !< steps between two applications of the shifting
+      real(rp) :: reference_steps = 1.0_rp          !< this step's length in reference steps (step_state_t)
       logical :: shifting_now = .false.             !< this step applies it
       real(rp) :: gravity(3) = 0.0_rp               !< grid frame: the hydrostatic pressure change of a shift
       real(rp), allocatable :: open_volume(:)       !< V_i per local node [m^dim], walls only
@@ -131,10 +137,12 @@ module volume_correction
 contains
 
    !> The options of every material of the scene.
-   subroutine corrector_init(self, scene, gravity)
+   !> `planned_reference_steps`: the longest step the scene's CFL numbers allow, in reference steps (the
+   !> shifting's interval is chosen for it).
+   subroutine corrector_init(self, scene, gravity, planned_reference_steps)
       class(volume_corrector_t), intent(inout) :: self
       type(scene_t), intent(in) :: scene
-      real(rp), intent(in) :: gravity(3)
+      real(rp), intent(in) :: gravity(3), planned_reference_steps
       integer :: m, n
       self%gravity = gravity
       n = size(scene%materials)
@@ -156,7 +164,7 @@ contains
       self%longest_shift = max_shift_in_cells * scene%grid%cell_size
       if (self%surface_model) call horizontal_frame(self, scene%grid%dim)
       if (self%shifting) self%interval = max(1, floor(coefficient_per_application / maxval(self%shifting_coefficient) &
-                                                       * (1.0_rp + 1.0e-12_rp)))
+                                                       / max(1.0_rp, planned_reference_steps) * (1.0_rp + 1.0e-12_rp)))
    end subroutine corrector_init
 
    !> The grid changed (layout): V_i is measured again at the next prepare.
@@ -170,6 +178,7 @@ contains
    subroutine corrector_walls_placed(self, state)
       class(volume_corrector_t), intent(inout) :: self
       type(step_state_t), intent(inout) :: state
+      self%reference_steps = state%reference_steps
       if (self%shifting) call self%prepare(state%domain, state%grid, state%constraints, state%particles, state%step)
    end subroutine corrector_walls_placed
 
@@ -197,7 +206,7 @@ contains
    subroutine corrector_stress_updated(self, state)
       class(volume_corrector_t), intent(inout) :: self
       type(step_state_t), intent(inout) :: state
-      if (self%relaxing) call self%relax_pressure(state%particles)
+      if (self%relaxing) call self%relax_pressure(state%particles, state%reference_steps)
    end subroutine corrector_stress_updated
 
    !> At x^n, before the step's particle-to-grid transfer, on the steps that shift (every interval-th step; by
@@ -271,8 +280,9 @@ contains
       call shifts_of_particles(self, grid, particles, self%open_volume >= threshold, kept)
    end subroutine corrector_measure_excess
 
-   !> dx_p = -D k h^2 sum_a grad N_a psi_a (k = interval) for the particles of shifting materials (the factor
-   !> -D k h^2 applied per cell by the transfer); the cap at 0.1 h comes with the application (apply_shifts).
+   !> dx_p = -D k a h^2 sum_a grad N_a psi_a (k = interval, a the step in reference steps: D holds per
+   !> reference step; D k a at most the stable 0.25) for the particles of shifting materials (the factor
+   !> -D k a h^2 applied per cell by the transfer); the cap at 0.1 h comes with the application (apply_shifts).
    !> A node mostly closed by walls has no reliable occupancy: it takes the particle's own excess (the
    !> N-weighted mean over the reliable corners), so a wall is neither a sink nor a source (zero normal
    !> gradient), where psi = 0 would pull particles onto it.
@@ -283,6 +293,7 @@ contains
       logical, intent(in) :: reliable(:)
       type(stencil_cache_t), intent(in), optional :: stencils
       integer :: m
+      real(rp) :: coefficient
       if (allocated(self%shift)) then
          if (size(self%shift, 2) < particles%count) deallocate (self%shift)
       end if
@@ -290,9 +301,11 @@ contains
       do m = 1, size(self%shifting_coefficient)
          if (self%shifting_coefficient(m) <= 0.0_rp) cycle
          if (particles%material_last(m) < particles%material_first(m)) cycle
+         coefficient = self%shifting_coefficient(m) * self%interval
+         if (self%reference_steps /= 1.0_rp) &
+            coefficient = min(stable_coefficient_per_application, coefficient * self%reference_steps)
          call gradient_at_particles(grid, particles, particles%material_first(m), particles%material_last(m), &
-                                    self%excess(1, :), reliable, self%shift, stencils, &
-                                    factor=-self%shifting_coefficient(m) * self%interval * grid%h**2)
+                                    self%excess(1, :), reliable, self%shift, stencils, factor=-coefficient * grid%h**2)
       end do
    end subroutine shifts_of_particles
 
@@ -348,15 +361,18 @@ contains
       end subroutine shift_particles
    end subroutine corrector_apply_shifts
 
-   !> After the stress update and smoothing: p := p + r (K ln(rho/rho_0) - p), deviatoric stress kept.
-   subroutine corrector_relax_pressure(self, particles)
+   !> After the stress update and smoothing: p := p + r_a (K ln(rho/rho_0) - p), deviatoric stress kept;
+   !> r_a = 1 - (1 - r)^a for a step of a reference steps, the part a reference steps of rate r remove.
+   subroutine corrector_relax_pressure(self, particles, reference_steps)
       class(volume_corrector_t), intent(in) :: self
       type(particle_set_t), intent(inout) :: particles
+      real(rp), intent(in) :: reference_steps
       integer :: m, p
       real(rp) :: pressure, change, rate, k, rho0
       do m = 1, size(self%relaxation_rate)
          if (self%relaxation_rate(m) <= 0.0_rp) cycle
          rate = self%relaxation_rate(m)
+         if (reference_steps /= 1.0_rp) rate = 1.0_rp - (1.0_rp - rate)**reference_steps
          k = self%bulk_modulus(m)
          rho0 = self%reference_density(m)
          do p = particles%material_first(m), particles%material_last(m)

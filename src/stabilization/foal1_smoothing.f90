@@ -11,7 +11,7 @@
 module foal1_smoothing
    use kinds, only: rp
    use particle_set, only: particle_set_t
-   use stabilizer, only: stage_context_t
+   use stabilizer, only: stage_context_t, smoothing_passes
    use c0_anti_locking, only: c0_anti_locking_t
    use cell_binning, only: cell_list_t, bin_cell_mass_and_centre, cell_average, bin_cell_mass_and_local_moments
    use cell_halo, only: padded_cells_t, exchange_cell_halo, halo_width
@@ -30,6 +30,7 @@ module foal1_smoothing
       real(rp), allocatable :: centre(:, :)    !< mass centre x_o^c of the owned cells at x^n (occupied ones)
       ! work arrays kept between steps
       real(rp), allocatable :: q_sums(:, :), field(:, :), dq(:, :)   !< q_sums: m_c q_c of the owned cells
+      real(rp), allocatable :: pass_dq(:, :)   !< one pass's increments, in a step of more than one
       logical, allocatable :: exists(:)
       integer, allocatable :: packed(:)        !< packed(1:n_packed): owned cells written into `field` by the last step
       integer :: n_packed = 0
@@ -85,7 +86,8 @@ contains
       type(stage_context_t), intent(in) :: context
       type(particle_set_t), intent(inout) :: particles
       real(rp), allocatable :: q(:, :)
-      integer :: first, last, nq, dim, p, c, i
+      real(rp) :: share
+      integer :: first, last, nq, dim, p, c, i, passes
 
       first = context%first
       last = context%last
@@ -128,11 +130,13 @@ contains
          self%packed(1:self%n_packed) = self%occupied%cells(1:self%n_packed)
          call exchange_cell_halo(context%domain, context%grid, self%box, field, flags=exists)
 
-         ! (d) limited face fluxes
+         ! (d) limited face fluxes, in as many passes as the step is reference steps long (smoothing_passes):
+         ! each pass from the cell values the last left, their ghost layers exchanged anew; dq ends as the
+         ! sum of the passes' increments and the packed q_c as they were
+         call smoothing_passes(context%reference_steps, passes, share)
          call field_flux_increments(self%box, context%grid%h, exists, field, self%options, dq, self%workspace)
-         ! a step shorter than the reference takes that part of the fluxes (they smooth again at every
-         ! step; a part of a limited increment stays within the limits); a longer step takes them whole
-         if (context%reference_steps < 1.0_rp) dq = context%reference_steps * dq
+         if (share < 1.0_rp) dq = share * dq
+         if (passes > 1) call further_passes(self, context, passes, share)
 
          ! (e) particle update
          if (self%pressure_only) then
@@ -162,6 +166,49 @@ contains
          end if
       end associate
    end subroutine foal1_filter_stress
+
+   !> Passes 2 to `passes` of step (d), dq holding the first's increments (scaled by share): the owned cells'
+   !> q_c advanced by the increments so far, their ghost layers exchanged (collective), the fluxes formed anew
+   !> and added to dq; afterwards the packed q_c are restored, so that q_c + dq is the smoothed value.
+   subroutine further_passes(self, context, passes, share)
+      type(foal1_smoothing_t), intent(inout) :: self
+      type(stage_context_t), intent(in) :: context
+      integer, intent(in) :: passes
+      real(rp), intent(in) :: share
+      integer :: pass, i, k, first_q
+      first_q = 3 + context%grid%dim
+      if (allocated(self%pass_dq)) then
+         if (any(shape(self%pass_dq) /= shape(self%dq))) deallocate (self%pass_dq)
+      end if
+      ! the workspace clears the box of cells its last call wrote, in whichever array it is given: within a
+      ! step every call has the same cells, so dq and pass_dq are both clear where a call writes
+      if (.not. allocated(self%pass_dq)) allocate (self%pass_dq(size(self%dq, 1), size(self%dq, 2)), source=0.0_rp)
+      associate (field => self%field, dq => self%dq, pass_dq => self%pass_dq)
+         do pass = 2, passes
+            do i = 1, self%n_packed
+               k = self%box%of_owned(self%packed(i))
+               if (pass == 2) then
+                  field(first_q:, k) = field(first_q:, k) + dq(:, k)
+               else
+                  field(first_q:, k) = field(first_q:, k) + pass_dq(:, k)
+               end if
+            end do
+            call exchange_cell_halo(context%domain, context%grid, self%box, field, flags=self%exists)
+            call field_flux_increments(self%box, context%grid%h, self%exists, field, self%options, pass_dq, &
+                                       self%workspace)
+            do i = 1, self%n_packed
+               k = self%box%of_owned(self%packed(i))
+               pass_dq(:, k) = share * pass_dq(:, k)
+               dq(:, k) = dq(:, k) + pass_dq(:, k)
+            end do
+         end do
+         ! back to the packed q_c: the passes advanced them by dq less the last pass's increments
+         do i = 1, self%n_packed
+            k = self%box%of_owned(self%packed(i))
+            field(first_q:, k) = field(first_q:, k) - (dq(:, k) - pass_dq(:, k))
+         end do
+      end associate
+   end subroutine further_passes
 
    !> Step (c) and the packing of the cell field in one pass over the slice's particles (sorted by cell, nearly):
    !> the sums m_c q_c of cell_binning's cell_sums, in the same order (kept in `sums`, which a run that comes
@@ -249,6 +296,7 @@ contains
       if (allocated(self%q_sums)) then
          if (size(self%q_sums, 2) == cell_count .and. size(self%field, 2) == self%box%count) return
          deallocate (self%q_sums, self%field, self%dq, self%exists, self%packed)
+         if (allocated(self%pass_dq)) deallocate (self%pass_dq)
       end if
       allocate (self%q_sums(nq, cell_count), self%field(2 + dim + nq, self%box%count), self%dq(nq, self%box%count), &
                 self%exists(self%box%count), self%packed(cell_count))

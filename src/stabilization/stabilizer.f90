@@ -22,8 +22,8 @@ module stabilizer
       type(grid_t), pointer :: grid => null()
       real(rp) :: dt = 0.0_rp
       !> the step's length in steps of the automatic length at the reference CFL number (1 at the default
-      !> step and with a fixed dt; mpm_solver's blend_per_step): a smoothing that acts once per step scales
-      !> its change by it, so that it acts at one rate per unit time
+      !> step and with a fixed dt; mpm_solver's blend_per_step): a smoothing that would act once per step
+      !> acts in smoothing_passes(reference_steps) passes instead, so that it acts at one rate per unit time
       real(rp) :: reference_steps = 1.0_rp
       !> the material is the only one with particles, on every rank: the grid's mass row of the step's P2G
       !> is its nodal mass (NB uses it)
@@ -54,8 +54,27 @@ module stabilizer
       end subroutine stage_interface
    end interface
 
+   public :: smoothing_passes
+
    !> A material's scheme; unallocated means standard MPM.
    type, public :: stabilizer_slot_t
       class(stabilizer_t), allocatable :: scheme
    end type stabilizer_slot_t
+contains
+
+   !> How a smoothing that acts once per reference step acts in a step of `reference_steps` reference steps
+   !> (docs/theory.md 5.1): in `passes` = ceiling(reference_steps) passes, each taking the part `share` =
+   !> reference_steps / passes of its change. A step shorter than the reference takes one pass of that part
+   !> (a part of a limited increment stays within the limits); a longer one takes the whole change more than
+   !> once, each pass from the values the last left, rather than once scaled (beyond the whole change a
+   !> limited flux is no longer limited). At the reference step: one whole pass.
+   pure subroutine smoothing_passes(reference_steps, passes, share)
+      real(rp), intent(in) :: reference_steps
+      integer, intent(out) :: passes
+      real(rp), intent(out) :: share
+      ! the step's length is a quotient of two computed steps: 1 + 1e-12 is the reference step
+      real(rp), parameter :: slack = 1.0e-9_rp
+      passes = max(1, ceiling(reference_steps - slack))
+      share = min(1.0_rp, reference_steps / passes)
+   end subroutine smoothing_passes
 end module stabilizer

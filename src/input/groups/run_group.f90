@@ -28,7 +28,7 @@ module run_group
    type, public :: run_control_t
       real(rp) :: end_time = -1.0_rp          !< simulated time to reach [s] (required)
       !> Courant number of the automatic time step; 0: the default of each material (the solver's
-      !> material_courant_numbers: 0.5 for now)
+      !> material_courant_numbers: 0.75 h / c for a fluid on multilinear functions but with C0, else 0.5)
       real(rp) :: cfl = 0.0_rp
       real(rp) :: fixed_dt = 0.0_rp           !< fixed time step [s]; 0 selects the CFL step
       real(rp) :: output_interval = 0.0_rp    !< simulated time between diagnostics rows [s]; 0: end_time/100

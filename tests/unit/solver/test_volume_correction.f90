@@ -23,7 +23,7 @@
 module test_volume_correction
    use kinds, only: rp, i8
    use mpi_f08, only: MPI_Comm, MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_INTEGER
-   use assertions, only: assertTrue, assertRelativelyEqual
+   use assertions, only: assertTrue, assertEqual, assertRelativelyEqual
    use error_status, only: status_t
    use scene_description, only: scene_t, wall_spec_t
    use mpm_solver, only: solver_t
@@ -47,6 +47,7 @@ module test_volume_correction
 
    public :: test_shifting_leaves_a_filled_tank_alone, test_shifting_spreads_crowded_particles, &
              test_eos_relaxation_keeps_the_eos_state, test_shift_takes_the_hydrostatic_pressure, &
+             test_eos_relaxation_per_unit_time, &
              test_shifting_lifts_a_crowded_surface_layer, test_fraction_below_a_plane, &
              test_shortcuts_are_the_general_way, test_height_function_skips_exactly, &
              test_lowest_height_is_minval
@@ -630,6 +631,38 @@ contains
       call solver%free()
    end subroutine test_eos_relaxation_keeps_the_eos_state
 
+   !> The relaxation acts at one rate per unit time: a step of 2.5 reference steps leaves a particle's pressure
+   !> where 2.5 steps of rate r would, p_EOS + (1 - r)^2.5 (p - p_EOS) (checked against two steps of 1 and one
+   !> of 0.5: (1 - r)^2 (1 - r)^0.5), the deviatoric stress untouched.
+   subroutine test_eos_relaxation_per_unit_time(comm)
+      type(MPI_Comm), intent(in) :: comm
+      type(volume_corrector_t) :: corrector
+      type(particle_set_t) :: one_step, steps
+      type(scene_t) :: scene
+      real(rp), parameter :: rate = 0.2_rp, sbar(4) = [-2.0_rp, -2.5_rp, -3.0_rp, 0.5_rp]   ! p = 2502.5 Pa
+      real(rp) :: eos, expected, long, short
+      scene = tank_scene('eos_relaxation', 2)
+      scene%materials(1)%eos_relaxation_rate = rate
+      call corrector%init(scene, [0.0_rp, -10.0_rp, 0.0_rp], 1.0_rp)
+      call one_step%init(2, 1, 4)
+      call one_step%add([1.0_rp, 1.0_rp], [0.0_rp, 0.0_rp], 1.0_rp, 1001.0_rp, sbar, 1, 1_i8)
+      call set_material_ranges(one_step)
+      steps = one_step
+      call corrector%relax_pressure(one_step, 2.5_rp)
+      call corrector%relax_pressure(steps, 1.0_rp)
+      call corrector%relax_pressure(steps, 1.0_rp)
+      call corrector%relax_pressure(steps, 0.5_rp)
+      eos = scene%materials(1)%bulk_modulus * log(1001.0_rp / scene%materials(1)%density)
+      expected = eos + (1.0_rp - rate)**2.5_rp * (2502.5_rp - eos)
+      long = -1001.0_rp * sum(one_step%sbar(1:3, 1)) / 3.0_rp
+      short = -1001.0_rp * sum(steps%sbar(1:3, 1)) / 3.0_rp
+      call assertTrue(abs(eos - 2502.5_rp) > 100.0_rp, 'the particle starts off the EOS')
+      call assertRelativelyEqual(expected, long, 1.0e-12_rp, 'one step of 2.5 reference steps')
+      call assertRelativelyEqual(expected, short, 1.0e-12_rp, 'steps of 1, 1 and 0.5 reference steps')
+      call assertRelativelyEqual(0.5_rp, one_step%sbar(4, 1), 1.0e-15_rp, 'shear kept')
+      call assertEqual(0.5_rp, one_step%sbar(1, 1) - one_step%sbar(2, 1), 1.0e-9_rp, 'deviator kept')
+   end subroutine test_eos_relaxation_per_unit_time
+
    !> A particle shifted by dx in a fluid at rest takes the pressure of its new place: p + rho g . dx
    !> (down by 1 cm under g = 10: +100 Pa at rho = 1000), the deviatoric stress and shear untouched.
    subroutine test_shift_takes_the_hydrostatic_pressure(comm)
@@ -637,7 +670,7 @@ contains
       type(volume_corrector_t) :: corrector
       type(particle_set_t) :: particles
       real(rp) :: sbar(4), pressure
-      call corrector%init(tank_scene('shifting', 2), [0.0_rp, -10.0_rp, 0.0_rp])
+      call corrector%init(tank_scene('shifting', 2), [0.0_rp, -10.0_rp, 0.0_rp], 1.0_rp)
       call particles%init(2, 1, 4)
       sbar = [-2.0_rp, -2.0_rp, -2.0_rp, 0.5_rp]            ! p = 2000 Pa at rho = 1000, a shear of 500 Pa
       call particles%add([1.0_rp, 1.0_rp], [0.0_rp, 0.0_rp], 1.0_rp, 1000.0_rp, sbar, 1, 1_i8)

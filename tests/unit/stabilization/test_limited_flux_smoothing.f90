@@ -10,12 +10,13 @@ module test_limited_flux_smoothing
    use background_grid, only: grid_t
    use cell_halo, only: padded_cells_t
    use limited_flux_smoothing, only: flux_options_t, flux_workspace_t, limited_flux_increments
+   use stabilizer, only: smoothing_passes
    implicit none
    private
 
    public :: test_conservation_random_field, test_maximum_principle, test_linear_field_unchanged, &
              test_checkerboard_2d, test_checkerboard_3d, test_empty_and_partial_cells, test_gamma_zero_no_flux, &
-             test_stress_kernels_match_general_code, test_workspace_reused
+             test_stress_kernels_match_general_code, test_workspace_reused, test_smoothing_passes
 
    real(rp), parameter :: h = 0.5_rp
 
@@ -348,6 +349,23 @@ contains
          call assertTrue(all(wide%dq == fresh%dq), 'a reused workspace gives the increments of a fresh one')
       end do
    end subroutine test_workspace_reused
+
+   !> A smoothing made per reference step in a step of a reference steps (stabilizer's smoothing_passes): one
+   !> pass of share a up to a = 1 (the reference step itself, to its round-off, whole), ceiling(a) passes of
+   !> a / ceiling(a) beyond, so that the passes' shares add up to a and none exceeds 1.
+   subroutine test_smoothing_passes()
+      real(rp), parameter :: steps(*) = [0.05_rp, 0.5_rp, 1.0_rp, 1.0_rp + 1.0e-12_rp, 1.5_rp, 2.0_rp, 2.12_rp, &
+                                         2.6_rp, 7.3_rp]
+      integer, parameter :: expected(*) = [1, 1, 1, 1, 2, 2, 3, 3, 8]
+      integer :: i, passes
+      real(rp) :: share
+      do i = 1, size(steps)
+         call smoothing_passes(steps(i), passes, share)
+         call assertEqual(expected(i), passes, 'passes')
+         call assertTrue(share <= 1.0_rp .and. share > 0.5_rp * min(1.0_rp, steps(i)), 'a share of at most 1')
+         call assertEqual(min(steps(i), 1.0_rp * passes), passes * share, 1.0e-11_rp, 'the shares add up to the step')
+      end do
+   end subroutine test_smoothing_passes
 
    !> Number of owned cells whose value 2 oscillates along axis k (eq. 6: the differences to both
    !> neighbours of opposite sign): each opens the faces along k on both of its sides.
