@@ -10,8 +10,8 @@ recommended settings, each compared with its measurements by scripts/compare_exp
    within 10 % NMAE over 0-1.5 s, P7 dry before 1.0 s.
 3. inputs/validation/spheric_test2_slice_2d.nml (the reservoir as a 2-D slice, no box): the reservoir's
    level H4 within 2.5 % NMAE over 0-1.0 s at h = 2 and 1 cm with the recommended settings (FOAL1, quadratic
-   B-splines); the same with multilinear shape functions is printed (4.1 % and 8.1 % when measured: the
-   crowding of docs/validation.md, worse on the finer grid), not checked.
+   B-splines); the same with multilinear shape functions is printed (4.41 % and 8.42 % when measured at
+   the default step: the crowding of docs/validation.md, worse on the finer grid), not checked.
 Each check of compare_experiment.py is one check here; the comparison tables (CSV) and figures (PNG) go
 to the working directory (--figures DIR elsewhere). About 3 minutes on 2 cores in Release, much longer in
 Debug. docs/validation.md, "Against flume experiments", lists what passes today and why the rest does not.
