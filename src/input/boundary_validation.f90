@@ -6,6 +6,7 @@ module boundary_validation
    use error_status, only: status_t
    use scene_description, only: scene_t, wall_spec_t, structure_spec_t, motion_spec_t, wall_friction, motion_none, &
                                 motion_solitary_wave, motion_table
+   use wave_validation, only: validate_wave_motion, stray_wave_variable
    use input_text, only: int_text, real_text, quoted_list, group_context
    use shape_geometry, only: shape_t, shape_problem, shape_bounds, box_corners, max_vertices, shape_box, &
                              shape_circle, shape_sphere, shape_cylinder, shape_polygon, shape_extruded_polygon
@@ -13,7 +14,7 @@ module boundary_validation
    use input_checks, only: check_real, check_name, is_none, name_detail, inside_tolerance, axis_letter
    use grid_group, only: wall_condition_keywords
    use wall_group, only: wall_group_condition_keywords
-   use motion_spec, only: motion_keywords
+   use motion_spec, only: motion_keywords, motion_regular_wave, motion_irregular_wave
    implicit none
    private
 
@@ -70,20 +71,24 @@ contains
    end subroutine validate_wall
 
    !> `&wall motion`, `&structure motion`: a known keyword; its variables given only with it; the solitary
-   !> wave's height and depth in range (A/h in (0, max_wave_ratio], gravity not zero) and its direction
-   !> (a wall's `normal`; a structure's motion_direction, required and not zero); the whole stroke keeps
-   !> the wall's point (`what` = 'wall', lower = upper) or the structure's box lower..upper (world, at
-   !> rest) in the scene box. A table is checked against the scene box when it is read (load_motion_tables).
+   !> wave's height and depth in range (A/h in (0, max_wave_ratio], gravity not zero), a piston's waves
+   !> as wave_validation says, and the direction of either (a wall's `normal`; a structure's
+   !> motion_direction, required and not zero); the whole stroke keeps the wall's point (`what` = 'wall',
+   !> lower = upper) or the structure's box lower..upper (world, at rest) in the scene box (a piston's waves:
+   !> either way). A table is checked against the scene box when it is read (load_motion_tables).
    subroutine validate_motion(spec, where, what, lower, upper, direction, scene, status)
       type(motion_spec_t), intent(in) :: spec
       character(len=*), intent(in) :: where, what
       real(rp), intent(in) :: lower(3), upper(3), direction(3)
       type(scene_t), intent(in) :: scene
       type(status_t), intent(inout) :: status
+      character(len=*), parameter :: wave_motions = "the wave motions ('"//motion_solitary_wave//"', '"// &
+                                                    motion_regular_wave//"', '"//motion_irregular_wave//"')"
       type(wall_motion_t) :: motion
       real(rp) :: g
       integer :: k, dim
-      character(len=:), allocatable :: excursion
+      logical :: waves, stroke
+      character(len=:), allocatable :: excursion, variable, owner
       if (.not. status%ok) return
       dim = scene%grid%dim
       if (all(spec%kind /= motion_keywords)) then
@@ -91,57 +96,62 @@ contains
                           trim(spec%kind)//"'")
          return
       end if
-      if (spec%kind /= motion_solitary_wave) then
-         if (spec%wave_height /= 0.0_rp) call refuse('wave_height')
-         if (spec%water_depth /= 0.0_rp) call refuse('water_depth')
-         if (any(spec%direction /= 0.0_rp)) call refuse('motion_direction')
-      end if
-      if (spec%kind == motion_none .and. spec%start /= 0.0_rp) call refuse('motion_start')
+      waves = spec%kind == motion_regular_wave .or. spec%kind == motion_irregular_wave
+      ! the motions along a direction: a stroke of a solitary wave or a piston's waves
+      stroke = waves .or. spec%kind == motion_solitary_wave
+      if (spec%kind /= motion_solitary_wave .and. spec%kind /= motion_regular_wave .and. spec%wave_height /= 0.0_rp) &
+         call refuse('wave_height', "motion = '"//motion_solitary_wave//"' or '"//motion_regular_wave//"'")
+      if (.not. stroke .and. spec%water_depth /= 0.0_rp) call refuse('water_depth', wave_motions)
+      if (.not. stroke .and. any(spec%direction /= 0.0_rp)) call refuse('motion_direction', wave_motions)
+      if (spec%kind == motion_none .and. spec%start /= 0.0_rp) call refuse('motion_start', 'a motion')
+      call stray_wave_variable(spec, variable, owner)
+      if (len(variable) > 0) call refuse(variable, owner)
       if (spec%kind /= motion_table) then
-         if (len_trim(spec%file) > 0) call refuse('motion_file')
-         if (len_trim(spec%checksum) > 0) call refuse('motion_checksum')
+         if (len_trim(spec%file) > 0) call refuse('motion_file', "motion = '"//motion_table//"'")
+         if (len_trim(spec%checksum) > 0) call refuse('motion_checksum', "motion = '"//motion_table//"'")
       else if (len_trim(spec%file) == 0) then
          call status%fail(where//": variable motion_file is required with motion = '"//motion_table// &
                           "' (a CSV of t, x, y[, z]: the "//what//"'s displacement)")
       end if
       if (spec%kind == motion_table .and. spec%start /= 0.0_rp) then
-         call status%fail(where//": variable motion_start belongs to motion = '"//motion_solitary_wave// &
-                          "' (a table gives its own times)")
+         call status%fail(where//": variable motion_start belongs to "//wave_motions// &
+                          " (a table gives its own times)")
       end if
-      if (.not. status%ok .or. spec%kind /= motion_solitary_wave) return
-      call check_real(where, 'motion_start', spec%start, status, at_least=0.0_rp)
-      call check_real(where, 'water_depth', spec%water_depth, status, greater_than=0.0_rp)
-      call check_real(where, 'wave_height', spec%wave_height, status, greater_than=0.0_rp, &
-                      at_most=max_wave_ratio * spec%water_depth)
-      g = norm2(scene%gravity(1:dim))
-      if (status%ok .and. g <= 0.0_rp) call status%fail(where//": variable motion = '"//motion_solitary_wave// &
-                                                        "' needs gravity (&gravity acceleration is zero)")
+      if (.not. status%ok .or. .not. stroke) return
+      if (waves) then
+         call validate_wave_motion(spec, where, scene, status)
+      else
+         call check_real(where, 'motion_start', spec%start, status, at_least=0.0_rp)
+         call check_real(where, 'water_depth', spec%water_depth, status, greater_than=0.0_rp)
+         call check_real(where, 'wave_height', spec%wave_height, status, greater_than=0.0_rp, &
+                         at_most=max_wave_ratio * spec%water_depth)
+         g = norm2(scene%gravity(1:dim))
+         if (status%ok .and. g <= 0.0_rp) call status%fail(where//": variable motion = '"//motion_solitary_wave// &
+                                                           "' needs gravity (&gravity acceleration is zero)")
+      end if
       if (what == 'structure') then
          do k = 1, dim
             call check_real(where, 'motion_direction('//int_text(k)//')', spec%direction(k), status)
          end do
          if (status%ok .and. .not. norm2(spec%direction(1:dim)) > 0.0_rp) &
-            call status%fail(where//": variable motion_direction is required with motion = '"//motion_solitary_wave// &
+            call status%fail(where//": variable motion_direction is required with motion = '"//trim(spec%kind)// &
                              "' (the direction of the stroke, not zero)")
       end if
       if (.not. status%ok) return
       motion = prescribed_motion(spec, direction, scene%gravity, dim)
-      ! the stroke is monotonic along its direction: its end is the farthest place
+      ! a solitary stroke is monotonic along its direction: its end is the farthest place; a piston's waves
+      ! reach the stroke either way
       excursion = box_excursion(scene%grid, what, lower, upper, motion%stroke() * motion%direction(1:dim))
+      if (len(excursion) == 0 .and. motion%oscillates()) &
+         excursion = box_excursion(scene%grid, what, lower, upper, -motion%stroke() * motion%direction(1:dim))
       if (len(excursion) > 0) call status%fail(where//": variable motion = '"//trim(spec%kind)//"' drives the "// &
                                                what//' out of the scene box of &grid: '//excursion)
 
    contains
 
-      subroutine refuse(variable)
-         character(len=*), intent(in) :: variable
-         character(len=:), allocatable :: owner
+      subroutine refuse(variable, owner)
+         character(len=*), intent(in) :: variable, owner
          if (.not. status%ok) return
-         ! motion_start belongs to every motion, motion_file and motion_checksum to the table, the others
-         ! to the solitary wave
-         owner = "motion = '"//motion_solitary_wave//"'"
-         if (variable == 'motion_start') owner = 'a motion'
-         if (variable == 'motion_file' .or. variable == 'motion_checksum') owner = "motion = '"//motion_table//"'"
          call status%fail(where//': variable '//variable//' belongs to '//owner//", which is not given (motion = '"// &
                           trim(spec%kind)//"')")
       end subroutine refuse

@@ -8,6 +8,7 @@ module scene_defaults
    use input_text, only: int_text
    use shape_geometry, only: shape_t, polygon_vertices, polygon_area, shape_polygon, shape_extruded_polygon
    use grid_group, only: side_name
+   use motion_spec, only: motion_spec_t, motion_regular_wave, motion_irregular_wave
    use material_group, only: find_material
    implicit none
    private
@@ -50,6 +51,7 @@ contains
             if (len_trim(wall%name) == 0) wall%name = default_name('wall', w)
             ! each component not given is the wall point's
             where (wall%moment_point >= huge(1.0_rp)) wall%moment_point = wall%point
+            call resolve_wave_defaults(wall%motion)
          end associate
       end do
       if (.not. allocated(scene%inlets)) allocate (scene%inlets(0))
@@ -75,6 +77,7 @@ contains
       do i = 1, size(scene%structures)
          associate (structure => scene%structures(i))
             if (len_trim(structure%name) == 0) structure%name = default_name('structure', i)
+            call resolve_wave_defaults(structure%motion)
             ! a box given by its corners becomes centre and size (validated: both corners, no centre/size)
             if (structure%lower(1) < huge(1.0_rp)) then
                structure%shape = structure_shape(structure, scene%grid%dim)
@@ -103,6 +106,16 @@ contains
          end associate
       end do
    end subroutine resolve_scene
+
+   !> A piston's waves: the ramp not given (< 0) two periods (peak periods) long, the irregular record not
+   !> given (0) 200 peak periods long (docs/input.md).
+   pure subroutine resolve_wave_defaults(motion)
+      type(motion_spec_t), intent(inout) :: motion
+      if (motion%kind == motion_regular_wave .and. motion%ramp_time < 0.0_rp) motion%ramp_time = 2.0_rp * motion%wave_period
+      if (motion%kind /= motion_irregular_wave) return
+      if (motion%ramp_time < 0.0_rp) motion%ramp_time = 2.0_rp * motion%peak_period
+      if (.not. motion%wave_duration > 0.0_rp) motion%wave_duration = 200.0_rp * motion%peak_period
+   end subroutine resolve_wave_defaults
 
    !> The point a structure's moment is taken about by default: the centre of a box, circle, sphere or
    !> cylinder, the centroid of a polygon's area (of an extruded polygon: at mid z_range), so that the

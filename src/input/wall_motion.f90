@@ -17,6 +17,8 @@
 !>    [-theta_0, theta_0], theta_0 = 3.8 (Goring's choice: its duration is his 2 (3.8 + A/h) / (k c)); the
 !>    paddle starts at 0.2 % of the wave's height (velocity 0.002 c A / h) and stops after the stroke
 !>    S = (2 A / (k h)) tanh(3.8) = 0.99900 x 2 A / (k h).
+!>  - regular_wave, irregular_wave: a piston's periodic or irregular stroke along the wall's normal (a
+!>    structure: its motion_direction), a sum of sines with a start-up ramp (wave_paddle).
 !>  - table: the displacement (x, y[, z]) of a CSV time table (`motion_file`, time_table: linear between
 !>    rows, the first / last row held outside them), read by rank 0 when the scene is read
 !>    (load_wall_tables) and broadcast with it; its velocity is piecewise constant.
@@ -26,6 +28,8 @@ module wall_motion
    use kinds, only: rp, path_len
    use error_status, only: status_t
    use scene_description, only: scene_t, grid_spec_t, motion_spec_t, motion_solitary_wave, motion_table, structure_shape
+   use motion_spec, only: motion_regular_wave, motion_irregular_wave, spectrum_pierson_moskowitz
+   use wave_paddle, only: paddle_signal_t, regular_signal, irregular_signal
    use shape_geometry, only: shape_bounds
    use time_table, only: time_table_t, read_time_table
    use csv_table, only: beside
@@ -33,7 +37,8 @@ module wall_motion
    implicit none
    private
 
-   integer, parameter, public :: motion_kind_none = 0, motion_kind_solitary = 1, motion_kind_table = 2
+   integer, parameter, public :: motion_kind_none = 0, motion_kind_solitary = 1, motion_kind_table = 2, &
+                                 motion_kind_waves = 3
 
    !> theta_0 of the solitary stroke (Goring 1978): the paddle starts where eta = A sech^2(3.8) = 0.002 A.
    real(rp), parameter, public :: solitary_theta0 = 3.8_rp
@@ -47,6 +52,8 @@ module wall_motion
       real(rp) :: wavenumber = 0.0_rp    !< k [1/m]
       real(rp) :: celerity = 0.0_rp      !< c [m/s]
       type(time_table_t) :: table        !< table: the displacement, columns x, y[, z] (world frame)
+      type(paddle_signal_t) :: signal    !< waves: the stroke along `direction` [m]
+      real(rp) :: record = 0.0_rp        !< waves: the time after which the stroke repeats [s]
    contains
       procedure :: displacement => motion_displacement
       procedure :: mean_velocity => motion_mean_velocity
@@ -54,6 +61,7 @@ module wall_motion
       procedure :: moving => motion_moving
       procedure :: stroke => motion_stroke
       procedure :: end_time => motion_end_time
+      procedure :: oscillates => motion_oscillates
    end type wall_motion_t
 
    public :: solitary_motion, prescribed_motion, load_motion_tables, box_excursion
@@ -89,11 +97,35 @@ contains
          motion%table = table
          return
       end if
-      if (spec%kind /= motion_solitary_wave) return
+      if (all(spec%kind /= [character(len=len(spec%kind)) :: motion_solitary_wave, motion_regular_wave, &
+                                                             motion_irregular_wave])) return
       unit = 0.0_rp
       unit(1:dim) = direction(1:dim) / norm2(direction(1:dim))
-      motion = solitary_motion(unit, spec%start, spec%wave_height, spec%water_depth, norm2(gravity(1:dim)))
+      if (spec%kind == motion_solitary_wave) then
+         motion = solitary_motion(unit, spec%start, spec%wave_height, spec%water_depth, norm2(gravity(1:dim)))
+         return
+      end if
+      motion%kind = motion_kind_waves
+      motion%direction = unit
+      motion%start = spec%start
+      if (spec%kind == motion_regular_wave) then
+         motion%record = spec%wave_period
+         motion%signal = regular_signal(spec%wave_height, spec%wave_period, spec%water_depth, norm2(gravity(1:dim)), &
+                                        spec%wave_order, spec%start, spec%ramp_time)
+      else
+         motion%record = spec%wave_duration
+         motion%signal = irregular_signal(spec%significant_wave_height, spec%peak_period, &
+                                          merge(1.0_rp, spec%gamma, spec%spectrum == spectrum_pierson_moskowitz), &
+                                          spec%wave_duration, spec%wave_seed, spec%water_depth, norm2(gravity(1:dim)), &
+                                          spec%start, spec%ramp_time)
+      end if
    end function prescribed_motion
+
+   !> The wall goes back and forth (a piston's waves): its stroke reaches `stroke` either way.
+   pure logical function motion_oscillates(self)
+      class(wall_motion_t), intent(in) :: self
+      motion_oscillates = self%kind == motion_kind_waves
+   end function motion_oscillates
 
    !> The wall moves at all (a fixed wall keeps its nodes and its arithmetic).
    pure logical function motion_moving(self)
@@ -101,11 +133,12 @@ contains
       motion_moving = self%kind /= motion_kind_none
    end function motion_moving
 
-   !> Length of the whole motion along `direction` [m] (solitary: S).
+   !> Length of the whole motion along `direction` [m] (solitary: S; waves: the largest |X| either way).
    pure real(rp) function motion_stroke(self) result(stroke)
       class(wall_motion_t), intent(in) :: self
       stroke = 0.0_rp
       if (self%kind == motion_kind_solitary) stroke = paddle_position(self, solitary_theta0)
+      if (self%kind == motion_kind_waves) stroke = self%signal%extent(self%record)
       if (self%kind == motion_kind_table) stroke = maxval(norm2(self%table%values, dim=1))
    end function motion_stroke
 
@@ -116,6 +149,7 @@ contains
       if (self%kind == motion_kind_solitary) &
          t = self%start + time_of_theta(self, solitary_theta0)
       if (self%kind == motion_kind_table) t = self%table%time(size(self%table%time))
+      if (self%kind == motion_kind_waves) t = huge(1.0_rp)
    end function motion_end_time
 
    !> Displacement from the scene position at time t, world frame [m].
@@ -126,6 +160,7 @@ contains
       d = 0.0_rp
       if (self%kind == motion_kind_solitary) d = paddle_position(self, theta_at(self, t)) * self%direction
       if (self%kind == motion_kind_table) d(1:size(self%table%values, 1)) = self%table%value_at(t)
+      if (self%kind == motion_kind_waves) d = self%signal%displacement(t) * self%direction
    end function motion_displacement
 
    !> Mean velocity over [t0, t1] (t1 > t0), world frame [m/s].
@@ -156,6 +191,7 @@ contains
          end associate
          return
       end if
+      if (self%kind == motion_kind_waves .and. t1 > self%start) speed = self%signal%speed_bound()
       if (self%kind /= motion_kind_solitary) return
       if (t1 <= self%start .or. t0 >= self%end_time()) return
       a = theta_at(self, t0)

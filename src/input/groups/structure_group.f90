@@ -57,7 +57,16 @@ module structure_group
       variable_info_t('structure', 'water_depth', 'real', .false.), &
       variable_info_t('structure', 'motion_direction', 'real3', .false.), &
       variable_info_t('structure', 'motion_file', 'string', .false.), &
-      variable_info_t('structure', 'motion_checksum', 'string', .false.)]
+      variable_info_t('structure', 'motion_checksum', 'string', .false.), &
+      variable_info_t('structure', 'wave_period', 'real', .false.), &
+      variable_info_t('structure', 'wave_order', 'integer', .false.), &
+      variable_info_t('structure', 'ramp_time', 'real', .false.), &
+      variable_info_t('structure', 'spectrum', 'string', .false.), &
+      variable_info_t('structure', 'significant_wave_height', 'real', .false.), &
+      variable_info_t('structure', 'peak_period', 'real', .false.), &
+      variable_info_t('structure', 'gamma', 'real', .false.), &
+      variable_info_t('structure', 'wave_seed', 'integer', .false.), &
+      variable_info_t('structure', 'wave_duration', 'real', .false.)]
 
 contains
 
@@ -69,13 +78,15 @@ contains
       integer, intent(out) :: ios
       character(len=*), intent(inout) :: message
       character(len=*), intent(in) :: text
-      character(len=text_len) :: name, shape, condition, motion, motion_file, motion_checksum
+      character(len=text_len) :: name, shape, condition, motion, motion_file, motion_checksum, spectrum
       real(rp) :: centre(3), size(3), rotation, rotation_axis(3), radius, axis(3), length, vertices(2 * max_vertices), &
                   z_range(2), lower(3), upper(3), friction, moment_point(3), motion_start, wave_height, water_depth, &
-                  motion_direction(3)
+                  motion_direction(3), wave_period, ramp_time, significant_wave_height, peak_period, gamma, wave_duration
+      integer :: wave_order, wave_seed
       namelist /structure/ name, shape, centre, size, rotation, rotation_axis, radius, axis, length, vertices, z_range, &
          lower, upper, condition, friction, moment_point, motion, motion_start, wave_height, water_depth, &
-         motion_direction, motion_file, motion_checksum
+         motion_direction, motion_file, motion_checksum, wave_period, wave_order, ramp_time, spectrum, &
+         significant_wave_height, peak_period, gamma, wave_seed, wave_duration
 
       name = spec%name
       shape = spec%shape%kind
@@ -86,13 +97,15 @@ contains
       friction = spec%friction
       moment_point = spec%moment_point
       call motion_to_locals(spec%motion, motion, motion_start, wave_height, water_depth, motion_direction, motion_file, &
-                            motion_checksum)
+                            motion_checksum, wave_period, wave_order, ramp_time, spectrum, significant_wave_height, &
+                            peak_period, gamma, wave_seed, wave_duration)
       read (text, nml=structure, iostat=ios, iomsg=message)
       call take_text('name', name, spec%name, ios, message)
       call take_text('shape', shape, spec%shape%kind, ios, message, fold='lower')
       call take_text('condition', condition, spec%condition, ios, message, fold='lower')
       call take_motion(motion, motion_start, wave_height, water_depth, motion_direction, motion_file, motion_checksum, &
-                       spec%motion, ios, message)
+                       wave_period, wave_order, ramp_time, spectrum, significant_wave_height, peak_period, gamma, &
+                       wave_seed, wave_duration, spec%motion, ios, message)
       if (ios /= 0) return
       call locals_to_shape(centre, size, rotation, rotation_axis, radius, axis, length, vertices, z_range, spec%shape)
       spec%lower = lower

@@ -51,7 +51,16 @@ module wall_group
       variable_info_t('wall', 'wave_height', 'real', .false.), &
       variable_info_t('wall', 'water_depth', 'real', .false.), &
       variable_info_t('wall', 'motion_file', 'string', .false.), &
-      variable_info_t('wall', 'motion_checksum', 'string', .false.)]
+      variable_info_t('wall', 'motion_checksum', 'string', .false.), &
+      variable_info_t('wall', 'wave_period', 'real', .false.), &
+      variable_info_t('wall', 'wave_order', 'integer', .false.), &
+      variable_info_t('wall', 'ramp_time', 'real', .false.), &
+      variable_info_t('wall', 'spectrum', 'string', .false.), &
+      variable_info_t('wall', 'significant_wave_height', 'real', .false.), &
+      variable_info_t('wall', 'peak_period', 'real', .false.), &
+      variable_info_t('wall', 'gamma', 'real', .false.), &
+      variable_info_t('wall', 'wave_seed', 'integer', .false.), &
+      variable_info_t('wall', 'wave_duration', 'real', .false.)]
 
 contains
 
@@ -61,11 +70,14 @@ contains
       integer, intent(out) :: ios
       character(len=*), intent(inout) :: message
       character(len=*), intent(in) :: text
-      character(len=text_len) :: condition, name, motion, motion_file, motion_checksum
+      character(len=text_len) :: condition, name, motion, motion_file, motion_checksum, spectrum
       real(rp) :: point(3), normal(3), lower(3), upper(3), moment_point(3), friction, motion_start, wave_height, &
-                  water_depth, motion_direction(3)
+                  water_depth, motion_direction(3), wave_period, ramp_time, significant_wave_height, peak_period, &
+                  gamma, wave_duration
+      integer :: wave_order, wave_seed
       namelist /wall/ point, normal, lower, upper, condition, friction, name, moment_point, motion, motion_start, &
-         wave_height, water_depth, motion_file, motion_checksum
+         wave_height, water_depth, motion_file, motion_checksum, wave_period, wave_order, ramp_time, spectrum, &
+         significant_wave_height, peak_period, gamma, wave_seed, wave_duration
 
       point = spec%point
       normal = spec%normal
@@ -76,12 +88,14 @@ contains
       name = spec%name
       moment_point = spec%moment_point
       call motion_to_locals(spec%motion, motion, motion_start, wave_height, water_depth, motion_direction, motion_file, &
-                            motion_checksum)
+                            motion_checksum, wave_period, wave_order, ramp_time, spectrum, significant_wave_height, &
+                            peak_period, gamma, wave_seed, wave_duration)
       read (text, nml=wall, iostat=ios, iomsg=message)
       call take_text('condition', condition, spec%condition, ios, message, fold='lower')
       call take_text('name', name, spec%name, ios, message)
       call take_motion(motion, motion_start, wave_height, water_depth, motion_direction, motion_file, motion_checksum, &
-                       spec%motion, ios, message)
+                       wave_period, wave_order, ramp_time, spectrum, significant_wave_height, peak_period, gamma, &
+                       wave_seed, wave_duration, spec%motion, ios, message)
       if (ios /= 0) return
       spec%point = point
       spec%normal = normal
