@@ -3,9 +3,11 @@
 scripts/wave_gauges.py from the level gauges of inputs/wave_flume.nml (H = 0.03 m, T = 1.028 s, h = 0.2 m,
 kh = 1).
 
-Default mode (run_waves, about 30 s in Debug): the flume at h/10 on 1 and 2 ranks to t = 0.8 s: the
+Default mode (run_waves, about 25 s in Debug): the flume at h/10 on 1 and 2 ranks to t = 0.8 s: the
 paddle's load and the gauges agree to 1e-10 (check_loads' rule: the motion is a function of time alone);
-on 2 ranks to 4 s: the paddle's load has the wave's period (its largest harmonic below 2 Hz at 1/T).
+on 2 ranks to 4 s: the paddle's load has the wave's period (its largest harmonic below 2 Hz at 1/T); a
+restart from the step-600 checkpoint gives loads.csv and gauges.csv byte for byte, and one with another
+wave_period is refused.
 --long (label validation, about 3 minutes on 2 cores in Release): the scene as it is, with Madsen's
 second-order stroke and with the first-order one, on 2 ranks: at the gauges 1, 2 and 3 wavelengths from the
 paddle the height (2 a1) within 5 % of H and the period within 1 % of T (the issue's criteria, checked
@@ -121,6 +123,54 @@ def run_short(checks, flotsam, inputs):
                  f"{peak:.3f} Hz against {1 / 1.028:.3f} Hz (resolution {resolution:.3f} Hz)")
 
 
+def run_restart(checks, flotsam, inputs):
+    """h/10 to 1.0 s on 2 ranks, checkpoints every 300 steps; again stopped at step 610 and continued from
+    the step-600 checkpoint: loads.csv and gauges.csv rows byte for byte (the stroke is a function of time
+    alone); a continuation with another wave_period is refused (exit 2, one line naming it)."""
+    import glob
+    import h5py
+    runs = {}
+    for name, extra in (("full", {}), ("split", {"max_steps": 610})):
+        folder = f"wave_restart_{name}"
+        flotsam.remove(folder)
+        path = flotsam.scene(os.path.join(inputs, "wave_flume.nml"), folder + ".nml", folder, end_time=1.0,
+                             checkpoint_interval_steps=300, **extra)
+        result = flotsam.run(path, 2, "--overwrite", "--set", "&grid cell_size = 0.02 /", timeout=1800)
+        if not checks.check(result.returncode == 0, f"restart: the {name} run on 2 ranks", result.stderr[-2000:]):
+            return
+        runs[name] = path
+    checkpoint = None
+    for candidate in sorted(glob.glob(flotsam.path("wave_restart_split", "checkpoints", "checkpoint_*.h5"))):
+        with h5py.File(candidate) as f:
+            if int(f.attrs["step"]) == 600:
+                checkpoint = candidate
+    if not checks.check(checkpoint is not None, "restart: a checkpoint at step 600"):
+        return
+    with open(runs["split"]) as f:
+        text = f.read().replace("\n   max_steps = 610", "")
+    continued = flotsam.path("wave_restart_continue.nml")
+    with open(continued, "w") as f:
+        f.write(text)
+    result = flotsam.run(continued, 2, "--restart", checkpoint, "--set", "&grid cell_size = 0.02 /", timeout=1800)
+    if not checks.check(result.returncode == 0, "restart: continued from step 600", result.stderr[-2000:]):
+        return
+    for file in ("loads.csv", "gauges.csv"):
+        rows = {}
+        for name in ("full", "split"):
+            with open(flotsam.path(f"wave_restart_{name}", file)) as f:
+                rows[name] = [line for line in f.read().splitlines() if not line.startswith("#")]
+        checks.check(rows["full"] == rows["split"] and len(rows["full"]) > 10,
+                     f"restart: {file} rows byte for byte ({len(rows['full'])} lines)",
+                     f"{len(rows['split'])} lines against {len(rows['full'])}")
+    newest = sorted(glob.glob(flotsam.path("wave_restart_split", "checkpoints", "checkpoint_*.h5")))[-1]
+    result = flotsam.run(continued, 2, "--restart", newest, "--set", "&grid cell_size = 0.02 /",
+                         "--set", "&wall name = 'paddle', wave_period = 1.1 /", timeout=600)
+    errors = [line for line in result.stderr.splitlines() if "flotsam: error:" in line]
+    checks.check(result.returncode == 2 and len(errors) == 1 and "wave_period" in errors[0],
+                 "restart: refused with another wave_period (exit 2, one line naming it)",
+                 f"exit {result.returncode}: {errors}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("flotsam")
@@ -139,6 +189,7 @@ def main():
         run_long(checks, flotsam, inputs, scripts, arguments.ranks)
     else:
         run_short(checks, flotsam, inputs)
+        run_restart(checks, flotsam, inputs)
     print(f"total {time.time() - started:.0f} s", flush=True)
     return checks.summary()
 
