@@ -71,6 +71,12 @@ def name_of(text):
     return text.strip().strip("'\"")
 
 
+def biesel(kh):
+    """Biesel's piston transfer function H / S = 2 (cosh 2kh - 1) / (sinh 2kh + 2kh) (2 beyond kh = 20)."""
+    kh = min(kh, 20.0)
+    return 4 * math.sinh(kh)**2 / (math.sinh(2 * kh) + 2 * kh)
+
+
 def wavenumber(omega, depth, g):
     """The root of omega^2 = g k tanh(k h) (Newton from Eckart's approximation)."""
     k = omega**2 / g / math.sqrt(math.tanh(omega**2 / g * depth))
@@ -124,25 +130,28 @@ class Wave:
         self.beat_length = 2 * math.pi / abs(2 * self.k - self.k2)
         # the free second harmonic of a first-order paddle: what Madsen's stroke X2 sin 2wt cancels, the
         # wave that stroke alone makes, m1(k2 h) X2 (Biesel at 2 omega)
-        m1 = 4 * math.sinh(kh)**2 / (math.sinh(2 * kh) + 2 * kh)
-        x2 = self.height**2 / (32 * self.depth) * (3 * math.cosh(kh) / math.sinh(kh)**3 - 2 / m1)
-        k2h = min(self.k2 * self.depth, 20.0)
-        self.free_first_order = abs(x2) * 4 * math.sinh(k2h)**2 / (math.sinh(2 * k2h) + 2 * k2h)
+        x2 = self.height**2 / (32 * self.depth) * (3 * math.cosh(kh) / math.sinh(kh)**3 - 2 / biesel(kh))
+        self.free_first_order = abs(x2) * biesel(self.k2 * self.depth)
 
     def distance(self, point):
         return sum((p - q) * d for p, q, d in zip(point, self.point, self.direction))
 
 
-def harmonic_fit(tt, eta, omega):
-    """Least squares of eta = m + sum_n (a_n cos n omega t + b_n sin n omega t), n = 1..3: (m, amplitudes,
-    residual)."""
+def harmonic_coefficients(tt, eta, omega):
+    """Least squares of eta = m + sum_n (a_n cos n omega t + b_n sin n omega t), n = 1..3: the coefficients
+    [m, a_1, b_1, a_2, b_2, a_3, b_3] and the sum of the squared residuals."""
     import numpy as np
     columns = [np.ones_like(tt)]
     for n in (1, 2, 3):
         columns += [np.cos(n * omega * tt), np.sin(n * omega * tt)]
     matrix = np.column_stack(columns)
     coefficients, *_ = np.linalg.lstsq(matrix, eta, rcond=None)
-    residual = float(np.sum((matrix @ coefficients - eta)**2))
+    return coefficients, float(np.sum((matrix @ coefficients - eta)**2))
+
+
+def harmonic_fit(tt, eta, omega):
+    """harmonic_coefficients as (m, the amplitudes of n = 1..3, residual)."""
+    coefficients, residual = harmonic_coefficients(tt, eta, omega)
     return coefficients[0], [math.hypot(coefficients[2 * n - 1], coefficients[2 * n]) for n in (1, 2, 3)], residual
 
 
@@ -187,11 +196,7 @@ def second_harmonic_across(t, series, wave, distances):
     tt = t[inside]
     amplitudes = []
     for level in series:
-        eta = level[inside] - wave.depth
-        columns = [np.ones_like(tt)]
-        for n in (1, 2, 3):
-            columns += [np.cos(n * wave.omega * tt), np.sin(n * wave.omega * tt)]
-        coefficients, *_ = np.linalg.lstsq(np.column_stack(columns), eta, rcond=None)
+        coefficients, _ = harmonic_coefficients(tt, level[inside] - wave.depth, wave.omega)
         amplitudes.append(coefficients[3] - 1j * coefficients[4])
     x = np.asarray(distances)
     amplitudes = np.asarray(amplitudes)

@@ -118,16 +118,18 @@ contains
                           " (a table gives its own times)")
       end if
       if (.not. status%ok .or. .not. stroke) return
+      ! what every wave motion needs: its start, the depth and gravity
+      call check_real(where, 'motion_start', spec%start, status, at_least=0.0_rp)
+      call check_real(where, 'water_depth', spec%water_depth, status, greater_than=0.0_rp)
+      g = norm2(scene%gravity(1:dim))
+      if (status%ok .and. .not. g > 0.0_rp) call status%fail(where//": variable motion = '"//trim(spec%kind)// &
+                                                             "' needs gravity (&gravity acceleration is zero)")
+      if (.not. status%ok) return
       if (waves) then
-         call validate_wave_motion(spec, where, scene, status)
+         call validate_wave_motion(spec, where, g, scene%grid%cell_size, status)
       else
-         call check_real(where, 'motion_start', spec%start, status, at_least=0.0_rp)
-         call check_real(where, 'water_depth', spec%water_depth, status, greater_than=0.0_rp)
          call check_real(where, 'wave_height', spec%wave_height, status, greater_than=0.0_rp, &
                          at_most=max_wave_ratio * spec%water_depth)
-         g = norm2(scene%gravity(1:dim))
-         if (status%ok .and. g <= 0.0_rp) call status%fail(where//": variable motion = '"//motion_solitary_wave// &
-                                                           "' needs gravity (&gravity acceleration is zero)")
       end if
       if (what == 'structure') then
          do k = 1, dim

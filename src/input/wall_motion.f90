@@ -91,34 +91,43 @@ contains
       integer, intent(in) :: dim
       type(time_table_t), intent(in), optional :: table
       type(wall_motion_t) :: motion
-      real(rp) :: unit(3)
+      real(rp) :: unit(3), g
       if (spec%kind == motion_table .and. present(table)) then
          motion%kind = motion_kind_table
          motion%table = table
          return
       end if
-      if (all(spec%kind /= [character(len=len(spec%kind)) :: motion_solitary_wave, motion_regular_wave, &
-                                                             motion_irregular_wave])) return
+      ! the other motions have no direction of their own (it may be zero)
+      if (spec%kind /= motion_solitary_wave .and. spec%kind /= motion_regular_wave .and. &
+          spec%kind /= motion_irregular_wave) return
       unit = 0.0_rp
       unit(1:dim) = direction(1:dim) / norm2(direction(1:dim))
-      if (spec%kind == motion_solitary_wave) then
-         motion = solitary_motion(unit, spec%start, spec%wave_height, spec%water_depth, norm2(gravity(1:dim)))
-         return
-      end if
-      motion%kind = motion_kind_waves
-      motion%direction = unit
-      motion%start = spec%start
-      if (spec%kind == motion_regular_wave) then
-         motion%record = spec%wave_period
-         motion%signal = regular_signal(spec%wave_height, spec%wave_period, spec%water_depth, norm2(gravity(1:dim)), &
-                                        spec%wave_order, spec%start, spec%ramp_time)
-      else
-         motion%record = spec%wave_duration
+      g = norm2(gravity(1:dim))
+      select case (spec%kind)
+      case (motion_solitary_wave)
+         motion = solitary_motion(unit, spec%start, spec%wave_height, spec%water_depth, g)
+      case (motion_regular_wave)
+         call waves_along(unit, spec%wave_period)
+         motion%signal = regular_signal(spec%wave_height, spec%wave_period, spec%water_depth, g, spec%wave_order, &
+                                        spec%start, spec%ramp_time)
+      case (motion_irregular_wave)
+         call waves_along(unit, spec%wave_duration)
          motion%signal = irregular_signal(spec%significant_wave_height, spec%peak_period, &
                                           merge(1.0_rp, spec%gamma, spec%spectrum == spectrum_pierson_moskowitz), &
-                                          spec%wave_duration, spec%wave_seed, spec%water_depth, norm2(gravity(1:dim)), &
-                                          spec%start, spec%ramp_time)
-      end if
+                                          spec%wave_duration, spec%wave_seed, spec%water_depth, g, spec%start, &
+                                          spec%ramp_time)
+      end select
+
+   contains
+
+      !> A piston's waves along `along`, repeating after `record` seconds.
+      pure subroutine waves_along(along, record)
+         real(rp), intent(in) :: along(3), record
+         motion%kind = motion_kind_waves
+         motion%direction = along
+         motion%start = spec%start
+         motion%record = record
+      end subroutine waves_along
    end function prescribed_motion
 
    !> The wall goes back and forth (a piston's waves): its stroke reaches `stroke` either way.

@@ -5,7 +5,7 @@
 module wave_validation
    use kinds, only: rp
    use error_status, only: status_t
-   use scene_description, only: scene_t, motion_spec_t
+   use scene_description, only: motion_spec_t
    use motion_spec, only: motion_regular_wave, motion_irregular_wave, spectrum_keywords, spectrum_jonswap, &
                           jonswap_gamma
    use input_text, only: int_text, real_text, quoted_list
@@ -32,9 +32,9 @@ module wave_validation
 
 contains
 
-   !> The first variable that belongs to the piston waves given without its motion (`variable`, '' if
-   !> none) and the motions it belongs to (`owner`): wave_period, wave_order with regular_wave, ramp_time
-   !> with either wave, spectrum .. wave_duration with irregular_wave.
+   !> A variable that belongs to the piston waves given without its motion (`variable`, '' if none; of
+   !> several, the last in the order below) and the motions it belongs to (`owner`): wave_period,
+   !> wave_order with regular_wave, ramp_time with either wave, spectrum .. wave_duration with irregular_wave.
    subroutine stray_wave_variable(spec, variable, owner)
       type(motion_spec_t), intent(in) :: spec
       character(len=:), allocatable, intent(out) :: variable, owner
@@ -61,19 +61,15 @@ contains
       if (spec%wave_duration /= defaults%wave_duration) variable = 'wave_duration'
    end subroutine stray_wave_variable
 
-   !> A regular or irregular wave of `spec` (its variables known to belong to it) at `where`, in `scene`
-   !> (gravity, cell size).
-   subroutine validate_wave_motion(spec, where, scene, status)
+   !> A regular or irregular wave of `spec` (its variables known to belong to it; its start, depth and
+   !> gravity checked by the caller) at `where`, under gravity `g` on cells of `cell` m.
+   subroutine validate_wave_motion(spec, where, g, cell, status)
       type(motion_spec_t), intent(in) :: spec
       character(len=*), intent(in) :: where
-      type(scene_t), intent(in) :: scene
+      real(rp), intent(in) :: g, cell
       type(status_t), intent(inout) :: status
-      real(rp) :: g, height, period
+      real(rp) :: height, period
       character(len=:), allocatable :: height_name, period_name
-      integer :: dim
-      dim = scene%grid%dim
-      call check_real(where, 'motion_start', spec%start, status, at_least=0.0_rp)
-      call check_real(where, 'water_depth', spec%water_depth, status, greater_than=0.0_rp)
       ! ramp_time < 0: not given (two periods)
       if (spec%ramp_time /= -1.0_rp) call check_real(where, 'ramp_time', spec%ramp_time, status, at_least=0.0_rp)
       if (spec%kind == motion_regular_wave) then
@@ -94,12 +90,7 @@ contains
       call check_real(where, height_name, height, status, greater_than=0.0_rp)
       call check_real(where, period_name, period, status, greater_than=0.0_rp)
       if (.not. status%ok) return
-      g = norm2(scene%gravity(1:dim))
-      if (.not. g > 0.0_rp) then
-         call status%fail(where//": variable motion = '"//trim(spec%kind)//"' needs gravity (&gravity acceleration is zero)")
-         return
-      end if
-      call check_wave_shape(spec, where, height_name, height, period_name, period, g, scene%grid%cell_size, status)
+      call check_wave_shape(spec, where, height_name, height, period_name, period, g, cell, status)
    end subroutine validate_wave_motion
 
    !> An irregular wave's spectrum, gamma, seed and record.
