@@ -65,6 +65,17 @@ def run_case(checks, flotsam, root, name, ranks, figures):
             checks.check(verdict == "PASS", f"{name}: {text}")
 
 
+def run_on_grid(checks, flotsam, scene, name, ranks, cell, shape):
+    """Run `scene` with &grid cell_size and shape_function set; the output folder's name, None if it failed."""
+    output = f"{name}_{shape}_{cell:g}"
+    flotsam.remove(output)
+    path = flotsam.scene(scene, f"{output}.nml", output)
+    result = flotsam.run(path, ranks, "--overwrite", "--set", f"&grid cell_size = {cell}, shape_function = '{shape}' /",
+                         timeout=3600)
+    ok = checks.check(result.returncode == 0, f"{name}: {shape}, h = {cell} m: run", result.stderr[-2000:])
+    return output if ok else None
+
+
 RESERVOIR = dict(scene="inputs/validation/spheric_test2_slice_2d.nml", tolerance=0.025, window=(0.0, 1.0),
                  cells=(0.02, 0.01))
 
@@ -77,12 +88,8 @@ def check_reservoir(checks, flotsam, root, ranks):
     t_exp = experiment.series["time"].to_numpy()
     for cell in RESERVOIR["cells"]:
         for shape in ("bspline2", "linear"):
-            output = f"reservoir_{shape}_{cell:g}"
-            flotsam.remove(output)
-            path = flotsam.scene(os.path.join(root, RESERVOIR["scene"]), f"{output}.nml", output)
-            result = flotsam.run(path, ranks, "--overwrite", "--set",
-                                 f"&grid cell_size = {cell}, shape_function = '{shape}' /", timeout=3600)
-            if not checks.check(result.returncode == 0, f"reservoir: {shape}, h = {cell} m: run", result.stderr[-2000:]):
+            output = run_on_grid(checks, flotsam, os.path.join(root, RESERVOIR["scene"]), "reservoir", ranks, cell, shape)
+            if output is None:
                 continue
             t_run, run = compare_experiment.read_run(flotsam.path(output))
             error = compare_experiment.nmae(t_run, run["H4"], t_exp, experiment.series["H4"].to_numpy(),
@@ -105,12 +112,9 @@ def check_wall_crowding(checks, flotsam, root, ranks):
     import pandas as pd
     largest = {}
     for cell, shape in [(c, "linear") for c in WALL_CROWDING["cells"]] + [(0.01, "bspline2")]:
-        output = f"wall_crowding_{shape}_{cell:g}"
-        flotsam.remove(output)
-        path = flotsam.scene(os.path.join(root, WALL_CROWDING["scene"]), f"{output}.nml", output)
-        result = flotsam.run(path, ranks, "--overwrite", "--set",
-                             f"&grid cell_size = {cell}, shape_function = '{shape}' /", timeout=3600)
-        if not checks.check(result.returncode == 0, f"wall_crowding: jet, {shape}, h = {cell} m: run", result.stderr[-2000:]):
+        output = run_on_grid(checks, flotsam, os.path.join(root, WALL_CROWDING["scene"]), "wall_crowding", ranks, cell,
+                             shape)
+        if output is None:
             continue
         gauges = pd.read_csv(flotsam.path(output, "gauges.csv"), comment="#")
         start, end = WALL_CROWDING["window"]
