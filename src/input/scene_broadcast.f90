@@ -23,7 +23,7 @@ contains
       type(MPI_Comm), intent(in) :: comm
       integer, intent(in) :: root
       character(len=1), allocatable :: bytes(:)
-      integer :: counts(8), rank_count(8), rank, n, at
+      integer :: counts(9), rank_count(9), rank, n, at
 
       ! -1 stands for "not allocated".
       counts = -1
@@ -35,6 +35,7 @@ contains
       if (allocated(scene%contacts)) counts(6) = size(scene%contacts)
       if (allocated(scene%structures)) counts(7) = size(scene%structures)
       if (allocated(scene%panels)) counts(8) = size(scene%panels)
+      if (allocated(scene%damping_zones)) counts(9) = size(scene%damping_zones)
       rank_count = counts
       call MPI_Bcast(counts, size(counts), MPI_INTEGER, root, comm)
       if (any(counts /= rank_count)) then
@@ -46,6 +47,7 @@ contains
          if (allocated(scene%contacts)) deallocate (scene%contacts)
          if (allocated(scene%structures)) deallocate (scene%structures)
          if (allocated(scene%panels)) deallocate (scene%panels)
+         if (allocated(scene%damping_zones)) deallocate (scene%damping_zones)
          if (counts(1) >= 0) allocate (scene%materials(counts(1)))
          if (counts(2) >= 0) allocate (scene%bodies(counts(2)))
          if (counts(3) >= 0) allocate (scene%walls(counts(3)))
@@ -54,6 +56,7 @@ contains
          if (counts(6) >= 0) allocate (scene%contacts(counts(6)))
          if (counts(7) >= 0) allocate (scene%structures(counts(7)))
          if (counts(8) >= 0) allocate (scene%panels(counts(8)))
+         if (counts(9) >= 0) allocate (scene%damping_zones(counts(9)))
       end if
 
       ! the parts one after the other, packed on root and unpacked in the same order elsewhere
@@ -70,6 +73,7 @@ contains
          if (counts(6) > 0) bytes = [bytes, transfer(scene%contacts, byte_mold)]
          if (counts(7) > 0) bytes = [bytes, transfer(scene%structures, byte_mold)]
          if (counts(8) > 0) bytes = [bytes, transfer(scene%panels, byte_mold)]
+         if (counts(9) > 0) bytes = [bytes, transfer(scene%damping_zones, byte_mold)]
          n = size(bytes)
       end if
       call MPI_Bcast(n, 1, MPI_INTEGER, root, comm)
@@ -102,6 +106,8 @@ contains
                                                         byte_mold))), scene%structures, counts(7))
       if (counts(8) > 0) scene%panels(:) = transfer(next_bytes(counts(8) * size(transfer(scene%panels(1), byte_mold))), &
                                                     scene%panels, counts(8))
+      if (counts(9) > 0) scene%damping_zones(:) = transfer(next_bytes(counts(9) * size(transfer(scene%damping_zones(1), &
+                                                           byte_mold))), scene%damping_zones, counts(9))
 
    contains
 

@@ -90,6 +90,7 @@ contains
          end associate
       end do
       if (.not. allocated(scene%panels)) allocate (scene%panels(0))
+      if (.not. allocated(scene%damping_zones)) allocate (scene%damping_zones(0))
       if (.not. allocated(scene%gauges)) allocate (scene%gauges(0))
       do g = 1, size(scene%gauges)
          associate (gauge => scene%gauges(g))

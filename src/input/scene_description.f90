@@ -17,6 +17,7 @@ module scene_description
    use gauge_group, only: gauge_spec_t, gauge_pressure, gauge_level, gauge_connected_level, gauge_velocity, &
                           gauge_wall_pressure
    use panel_group, only: panel_spec_t, panel_surface, panel_load_cell
+   use damping_zone_group, only: damping_zone_spec_t
    use contact_group, only: contact_spec_t
    implicit none
    private
@@ -33,7 +34,7 @@ module scene_description
    public :: structure_spec_t, structure_shape
    public :: inlet_spec_t, has_velocity_file, opening_tangent, opening_far_end
    public :: gauge_spec_t, gauge_pressure, gauge_level, gauge_connected_level, gauge_velocity, gauge_wall_pressure
-   public :: panel_spec_t, panel_surface, panel_load_cell
+   public :: panel_spec_t, panel_surface, panel_load_cell, damping_zone_spec_t
    public :: contact_spec_t
 
    !> The points of a `&body points_file` (empty for the other bodies): world positions and volumes.
@@ -64,5 +65,6 @@ module scene_description
       type(gauge_spec_t), allocatable :: gauges(:)
       type(panel_spec_t), allocatable :: panels(:)     !< `&panel` groups (panels.csv)
       type(contact_spec_t), allocatable :: contacts(:)
+      type(damping_zone_spec_t), allocatable :: damping_zones(:)   !< `&damping_zone` groups
    end type scene_t
 end module scene_description

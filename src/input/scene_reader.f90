@@ -21,6 +21,7 @@ module scene_reader
    use scene_variables, only: variable_info_t, value_too_long
    use gauge_group, only: gauge_variables, read_gauge_group
    use panel_group, only: panel_variables, read_panel_group
+   use damping_zone_group, only: damping_zone_variables, read_damping_zone_group, damping_zone_spec_t
    use body_group, only: body_variables, read_body_group
    use structure_group, only: structure_variables, read_structure_group
    use wall_group, only: wall_variables, read_wall_group
@@ -58,13 +59,14 @@ module scene_reader
 
    !> The namelist groups of a scene file, in the order a resolved scene is written (scene_record).
    character(len=*), parameter, public :: known_groups(*) = &
-      [character(len=9) :: 'run', 'grid', 'box_walls', 'gravity', 'material', 'body', 'wall', 'inlet', 'gauge', &
-                           'panel', 'structure', 'contact']
+      [character(len=12) :: 'run', 'grid', 'box_walls', 'gravity', 'material', 'body', 'wall', 'inlet', 'gauge', &
+                            'panel', 'structure', 'contact', 'damping_zone']
    !> Groups that may appear at most once.
-   character(len=*), parameter :: singleton_groups(*) = [character(len=9) :: 'run', 'grid', 'box_walls', 'gravity']
+   character(len=*), parameter :: singleton_groups(*) = [character(len=12) :: 'run', 'grid', 'box_walls', 'gravity']
    !> Groups that may appear any number of times, one scene entry each.
    character(len=*), parameter, public :: repeated_groups(*) = &
-      [character(len=9) :: 'material', 'body', 'wall', 'inlet', 'gauge', 'panel', 'structure', 'contact']
+      [character(len=12) :: 'material', 'body', 'wall', 'inlet', 'gauge', 'panel', 'structure', 'contact', &
+                            'damping_zone']
    !> Groups a scene file must contain.
    character(len=*), parameter :: required_groups(*) = [character(len=8) :: 'run', 'grid', 'material']
 
@@ -81,6 +83,7 @@ module scene_reader
       inlet_variables, &
       gauge_variables, &
       panel_variables, &
+      damping_zone_variables, &
       contact_variables, &
       structure_variables]
 
@@ -222,7 +225,7 @@ contains
       call read_singleton_groups(file, scene, status)
       if (.not. status%ok) return
       allocate (probe%materials(1), probe%bodies(1), probe%walls(1), probe%inlets(1), probe%gauges(1), probe%panels(1), &
-                probe%structures(1), probe%contacts(1))
+                probe%structures(1), probe%contacts(1), probe%damping_zones(1))
       do g = 1, size(file%groups)
          group = file%groups(g)%name
          if (.not. any(repeated_groups == group)) cycle
@@ -266,7 +269,7 @@ contains
       character(len=*), intent(in) :: group
       character(len=:), allocatable :: name
       select case (group)
-      case ('material', 'wall', 'gauge', 'panel', 'structure')
+      case ('material', 'wall', 'gauge', 'panel', 'structure', 'damping_zone')
          name = 'name'
       case ('body', 'inlet')
          name = 'material'
@@ -299,6 +302,8 @@ contains
          value = trim(scene%gauges(i)%name)
       case ('panel')
          value = trim(scene%panels(i)%name)
+      case ('damping_zone')
+         value = trim(scene%damping_zones(i)%name)
       case ('structure')
          ! an unnamed structure is selected by its default name (structure_<k>)
          value = trim(scene%structures(i)%name)
@@ -328,6 +333,8 @@ contains
          if (allocated(scene%gauges)) n = size(scene%gauges)
       case ('panel')
          if (allocated(scene%panels)) n = size(scene%panels)
+      case ('damping_zone')
+         if (allocated(scene%damping_zones)) n = size(scene%damping_zones)
       case ('contact')
          if (allocated(scene%contacts)) n = size(scene%contacts)
       case ('structure')
@@ -448,6 +455,7 @@ contains
       type(inlet_spec_t) :: default_inlet
       type(gauge_spec_t) :: default_gauge
       type(panel_spec_t) :: default_panel
+      type(damping_zone_spec_t) :: default_damping_zone
       type(contact_spec_t) :: default_contact
       type(structure_spec_t) :: default_structure
       character(len=512) :: message
@@ -456,9 +464,10 @@ contains
 
       allocate (scene%materials(file%count('material')), scene%bodies(file%count('body')), &
                 scene%walls(file%count('wall')), scene%inlets(file%count('inlet')), scene%gauges(file%count('gauge')), &
-                scene%panels(file%count('panel')), scene%structures(file%count('structure')), scene%contacts(file%count('contact')))
+                scene%panels(file%count('panel')), scene%structures(file%count('structure')), &
+                scene%contacts(file%count('contact')), scene%damping_zones(file%count('damping_zone')))
       allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1), one%gauges(1), one%panels(1), one%structures(1), &
-                one%contacts(1))
+                one%contacts(1), one%damping_zones(1))
       do g = 1, size(repeated_groups)
          group = trim(repeated_groups(g))
          do k = 1, file%count(group)
@@ -468,6 +477,7 @@ contains
             one%inlets(1) = default_inlet
             one%gauges(1) = default_gauge
             one%panels(1) = default_panel
+            one%damping_zones(1) = default_damping_zone
             one%contacts(1) = default_contact
             one%structures(1) = default_structure
             message = ''
@@ -489,6 +499,8 @@ contains
                scene%gauges(k) = one%gauges(1)
             case ('panel')
                scene%panels(k) = one%panels(1)
+            case ('damping_zone')
+               scene%damping_zones(k) = one%damping_zones(1)
             case ('contact')
                scene%contacts(k) = one%contacts(1)
             case ('structure')
@@ -522,6 +534,8 @@ contains
             where = group_context(file%path, group, k, name_detail(scene%gauges(k)%name))
          case ('panel')
             where = group_context(file%path, group, k, name_detail(scene%panels(k)%name))
+         case ('damping_zone')
+            where = group_context(file%path, group, k, name_detail(scene%damping_zones(k)%name))
          case ('contact')
             where = group_context(file%path, group, k)
          case ('structure')
@@ -610,7 +624,7 @@ contains
          return
       end if
       allocate (one%materials(1), one%bodies(1), one%walls(1), one%inlets(1), one%gauges(1), one%panels(1), one%structures(1), &
-                one%contacts(1))
+                one%contacts(1), one%damping_zones(1))
       associate (items => file%groups(g)%items)
          do i = 1, size(items)
             prefix = file%path//': line '//int_text(items(i)%line)//': group &'//group//label
@@ -737,6 +751,8 @@ contains
          call read_gauge_group(scene%gauges(k), ios, message, text)
       case ('panel')
          call read_panel_group(scene%panels(k), ios, message, text)
+      case ('damping_zone')
+         call read_damping_zone_group(scene%damping_zones(k), ios, message, text)
       case ('contact')
          call read_contact_group(scene%contacts(k), ios, message, text)
       case ('structure')

@@ -21,6 +21,7 @@ module scene_record
    use inlet_group, only: inlet_value
    use gauge_group, only: gauge_value
    use panel_group, only: panel_value
+   use damping_zone_group, only: damping_zone_value
    use contact_group, only: contact_value
    implicit none
    private
@@ -113,6 +114,8 @@ contains
          text = gauge_value(scene%gauges(k), name)
       case ('panel')
          text = panel_value(scene%panels(k), name)
+      case ('damping_zone')
+         text = damping_zone_value(scene%damping_zones(k), name)
       case ('contact')
          text = contact_value(scene%contacts(k), name)
       case ('structure')

@@ -24,6 +24,7 @@ module scene_validation
    use sensor_validation, only: validate_gauge_walls, validate_panel_walls, validate_load_names
    use gauge_group, only: validate_gauge
    use panel_group, only: validate_panel
+   use damping_zone_group, only: validate_damping_zone
    implicit none
    private
 
@@ -107,6 +108,12 @@ contains
       end if
       call validate_panel_walls(scene, path, status)
       if (.not. status%ok) return
+      if (allocated(scene%damping_zones)) then
+         do i = 1, size(scene%damping_zones)
+            call validate_damping_zone(scene%damping_zones, i, scene%grid, path, status)
+            if (.not. status%ok) return
+         end do
+      end if
       if (allocated(scene%contacts)) then
          do i = 1, size(scene%contacts)
             call validate_contact(scene%contacts, i, scene%materials, scene%structures, path, status)

@@ -11,7 +11,7 @@ module scene_variables
 
    !> A variable of a group: its kind names the expected value in messages.
    type, public :: variable_info_t
-      character(len=9) :: group
+      character(len=12) :: group
       character(len=26) :: name
       character(len=7) :: kind          !< real, real3, reals (a list), integer, logical, string or string2 (two strings)
       logical :: required

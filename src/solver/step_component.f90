@@ -1,8 +1,8 @@
 !> A feature of the step that acts at fixed stages of it (algorithms.md section 1.2), present only when
 !> the scene declares it: the solver holds the scene's components as one list (step_component_factory)
 !> and calls each stage of every component in list order; a scene without such features has an empty
-!> list, and its step runs no test for them. Today: the inflow (fluid_inflow) and the fluid volume
-!> correction (volume_correction). A new one extends step_component_t, overrides the stages it uses
+!> list, and its step runs no test for them. Today: the inflow (fluid_inflow), the fluid volume
+!> correction (volume_correction) and the damping zones (damping_zone). A new one extends step_component_t, overrides the stages it uses
 !> (each default does nothing) and is added in step_component_factory (docs/conventions.md, "Where to
 !> add ...").
 !>

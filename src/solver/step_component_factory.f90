@@ -1,14 +1,15 @@
 !> The step's components (step_component) of a scene, in the order the step calls them at each stage:
-!> the inflow if the scene has inlets, the volume correction if a fluid selects one. A scene with neither
-!> has an empty list. A new component is one `if` here.
+!> the inflow if the scene has inlets, the volume correction if a fluid selects one, the damping zones if
+!> the scene has any. A scene with none of them has an empty list. A new component is one `if` here.
 module step_component_factory
    use kinds, only: rp, i8
    use scene_description, only: scene_t
    use constraint_list, only: constraint_list_t
    use step_component, only: step_component_t, component_slot_t
-   use phase_timers, only: phase_inflow, phase_volume_correction
+   use phase_timers, only: phase_inflow, phase_volume_correction, phase_grid_to_particles
    use fluid_inflow, only: inflow_t, build_inlets
    use volume_correction, only: volume_corrector_t
+   use damping_zone, only: damping_zones_t
    implicit none
    private
 
@@ -27,6 +28,7 @@ contains
       type(component_slot_t), allocatable, intent(out) :: components(:)
       type(inflow_t), allocatable :: inflow
       type(volume_corrector_t), allocatable :: volume
+      type(damping_zones_t), allocatable :: damping
 
       allocate (components(0))
       if (allocated(scene%inlets)) then
@@ -42,6 +44,15 @@ contains
       if (volume%shifting .or. volume%relaxing) then
          volume%phase = phase_volume_correction
          call append(components, volume)
+      end if
+      if (allocated(scene%damping_zones)) then
+         if (size(scene%damping_zones) > 0) then
+            allocate (damping)
+            ! a change of the particles' velocities right after G2P: charged to it
+            damping%phase = phase_grid_to_particles
+            call damping%init(scene)
+            call append(components, damping)
+         end if
       end if
    end subroutine build_step_components
 
