@@ -24,6 +24,10 @@ the paddle's):
 and over all the gauges, in the window common to them, the second harmonic's complex amplitude at each
 fitted as B exp(-2ikx) + F exp(-i k2 x): the bound harmonic B (against Stokes') and the free one F that a
 first-order paddle also makes (Madsen's second-order stroke removes it), with what neither explains.
+The first harmonic over the gauges likewise as A exp(-ikx) + R exp(ikx) (Mansard & Funke 1980's least
+squares, with any number of gauges from 3): the incident and the reflected wave and the reflection
+coefficient |R| / |A|, over --start .. --end when given (a window after the far end's reflection has
+arrived; default: the common window as for the second harmonic).
 
 Prints a table and (--csv) writes it (read with pandas.read_csv(path, comment='#')). --check: exit status 1
 unless the height is within 5 % of H and the period within 1 % of T at every gauge (issue 54's criteria).
@@ -180,31 +184,55 @@ def analyse(t, level, wave, x, start, end):
                 a1=harmonics[0], a2=harmonics[1], a3=harmonics[2], mean_level=float(mean))
 
 
-def second_harmonic_across(t, series, wave, distances):
-    """The second harmonic over the gauges: in the window common to all of them, each gauge's complex
-    amplitude c(x) of exp(2 i omega t) at the paddle's frequency, fitted as B exp(-2ikx) + F exp(-i k2 x):
-    the bound harmonic (travelling with the wave) and the free one (at its own wavenumber k2), with the
-    RMS of what neither explains. None with fewer than 3 gauges or 2 periods."""
-    import numpy as np
-    if len(distances) < 3:
-        return None
-    first = wave.start + wave.ramp + max(distances) / wave.group_velocity + 2 * wave.period
-    periods = math.floor((t[-1] - first) / wave.period + 1e-9)
+def common_window(t, wave, distances, start=None, end=None):
+    """The window of whole periods common to the gauges at `distances` (from after the ramp has passed
+    the farthest, or `start`, to the last row or `end`): (first, last), None below 2 periods."""
+    first = wave.start + wave.ramp + max(distances) / wave.group_velocity + 2 * wave.period if start is None else start
+    periods = math.floor(((t[-1] if end is None else end) - first) / wave.period + 1e-9)
     if periods < 2:
         return None
-    inside = (t >= first) & (t <= first + periods * wave.period)
+    return first, first + periods * wave.period
+
+
+def split_across(t, series, wave, distances, n, wavenumbers, window):
+    """Each gauge's complex amplitude c(x) of exp(i n omega t) at the paddle's frequency over `window`,
+    fitted as sum_j C_j exp(-i kappa_j x) for the given wavenumbers kappa_j: (|C_j|, the RMS of what they
+    leave unexplained)."""
+    import numpy as np
+    inside = (t >= window[0]) & (t <= window[1])
     tt = t[inside]
     amplitudes = []
     for level in series:
         coefficients, _ = harmonic_coefficients(tt, level[inside] - wave.depth, wave.omega)
-        amplitudes.append(coefficients[3] - 1j * coefficients[4])
+        amplitudes.append(coefficients[2 * n - 1] - 1j * coefficients[2 * n])
     x = np.asarray(distances)
     amplitudes = np.asarray(amplitudes)
-    basis = np.column_stack([np.exp(-2j * wave.k * x), np.exp(-1j * wave.k2 * x)])
+    basis = np.column_stack([np.exp(-1j * kappa * x) for kappa in wavenumbers])
     solution, *_ = np.linalg.lstsq(basis, amplitudes, rcond=None)
-    residual = float(np.sqrt(np.mean(np.abs(amplitudes - basis @ solution)**2)))
-    return dict(start=first, end=first + periods * wave.period, bound=abs(solution[0]), free=abs(solution[1]),
-                residual=residual, gauges=len(distances))
+    return [abs(c) for c in solution], float(np.sqrt(np.mean(np.abs(amplitudes - basis @ solution)**2)))
+
+
+def second_harmonic_across(t, series, wave, distances):
+    """The second harmonic over the gauges: B exp(-2ikx) + F exp(-i k2 x), the bound harmonic (travelling
+    with the wave) and the free one (at its own wavenumber k2), with the RMS of what neither explains. None
+    with fewer than 3 gauges or 2 periods."""
+    window = common_window(t, wave, distances) if len(distances) >= 3 else None
+    if window is None:
+        return None
+    (bound, free), residual = split_across(t, series, wave, distances, 2, [2 * wave.k, wave.k2], window)
+    return dict(start=window[0], end=window[1], bound=bound, free=free, residual=residual, gauges=len(distances))
+
+
+def reflection_across(t, series, wave, distances, start=None, end=None):
+    """The first harmonic over the gauges as an incident and a reflected wave, A exp(-ikx) + R exp(ikx)
+    (Mansard & Funke 1980's least squares, with any number of gauges at least 3): their amplitudes and the
+    reflection coefficient |R| / |A|. None with fewer than 3 gauges or 2 periods."""
+    window = common_window(t, wave, distances, start, end) if len(distances) >= 3 else None
+    if window is None:
+        return None
+    (incident, reflected), residual = split_across(t, series, wave, distances, 1, [wave.k, -wave.k], window)
+    return dict(start=window[0], end=window[1], incident=incident, reflected=reflected,
+                coefficient=reflected / incident, residual=residual, gauges=len(distances))
 
 
 def main():
@@ -257,6 +285,13 @@ def main():
               f"{1000 * across['free']:.3f} mm (a first-order paddle's by Madsen: {1000 * wave.free_first_order:.3f} mm; beat "
               f"length {wave.beat_length:.3f} m), unexplained "
               f"{1000 * across['residual']:.3f} mm RMS per gauge")
+    reflection = reflection_across(t, [data[f"{name}_level"].to_numpy() for name, _ in levels], wave,
+                                   [wave.distance(point) for _, point in levels], arguments.start, arguments.end)
+    if reflection:
+        print(f"first harmonic over the {reflection['gauges']} gauges ({reflection['start']:.2f}-{reflection['end']:.2f} s): "
+              f"incident {1000 * reflection['incident']:.3f} mm, reflected {1000 * reflection['reflected']:.3f} mm, "
+              f"reflection coefficient {reflection['coefficient']:.3f}, unexplained {1000 * reflection['residual']:.3f} mm "
+              "RMS per gauge")
     if arguments.csv:
         header = ["gauge", "x", "window_start", "window_end", "periods", "height", "height_error", "period",
                   "period_error", "a1", "a2", "a3", "mean_level"]
@@ -268,6 +303,10 @@ def main():
                       f"bound Stokes second harmonic {wave.bound_second:.6g} m\n")
             out.write("# units: x m (from the paddle along its stroke); window_start, window_end, period s; periods "
                       "count (whole periods in the window); height, a1, a2, a3, mean_level m (mean_level: above still water); *_error relative\n")
+            if reflection:
+                out.write(f"# first harmonic over the gauges ({reflection['start']:.6g}-{reflection['end']:.6g} s): "
+                          f"incident {reflection['incident']:.6g} m, reflected {reflection['reflected']:.6g} m, "
+                          f"reflection coefficient {reflection['coefficient']:.6g}\n")
             if across:
                 out.write(f"# second harmonic over the gauges ({across['start']:.6g}-{across['end']:.6g} s): bound "
                           f"{across['bound']:.6g} m, free {across['free']:.6g} m, unexplained {across['residual']:.6g} m "
