@@ -8,7 +8,7 @@ module body_validation
    use shape_geometry, only: shape_t, shape_problem, shape_bounds, max_vertices, no_vertex, shape_box, shape_circle, &
                              shape_sphere, shape_cylinder, shape_polygon, shape_extruded_polygon
    use body_lattice, only: has_points_file, box_corners_given, body_shape, count_particles, particle_spacing
-   use input_checks, only: check_real, check_name, differs, inside_tolerance, axis_letter
+   use input_checks, only: check_real, check_upper_above_lower, check_name, differs, inside_tolerance, axis_letter
    use material_group, only: find_material
    implicit none
    private
@@ -109,13 +109,8 @@ contains
       if (abs(body%shape%rotation) > 0.0_rp .or. .not. box_corners_given(body, grid%dim)) then
          ! a turned box, or one given by centre/size: as the other shapes
          if (box_corners_given(body, grid%dim)) then
-            do k = 1, grid%dim
-               if (.not. (body%upper(k) > body%lower(k))) then
-                  call status%fail(where//': variable upper('//int_text(k)//') must be > lower('//int_text(k)// &
-                                   ') = '//real_text(body%lower(k))//', got '//real_text(body%upper(k)))
-                  return
-               end if
-            end do
+            call check_upper_above_lower(where, body%lower, body%upper, grid%dim, status)
+            if (.not. status%ok) return
          end if
          call validate_shape(body, where, grid, status)
          return

@@ -10,13 +10,31 @@ module input_checks
    implicit none
    private
 
-   public :: check_real, check_name, is_identifier, is_none, differs, pair_text, given_or, count_text, name_detail
+   public :: check_real, check_upper_above_lower, check_name, is_identifier, is_none, differs, pair_text, given_or, &
+             count_text, name_detail
 
    !> Tolerance of "body inside the grid", in cell sizes.
    real(rp), parameter, public :: inside_tolerance = 1.0e-9_rp
    character(len=1), parameter, public :: axis_letter(3) = ['x', 'y', 'z']
 
 contains
+
+   !> Fail with "<where>: variable upper(k) must be > lower(k) = <lower>, got <upper>" for the first of the
+   !> dim axes on which the box lower .. upper has no length (the corners themselves already checked finite).
+   subroutine check_upper_above_lower(where, lower, upper, dim, status)
+      character(len=*), intent(in) :: where
+      real(rp), intent(in) :: lower(:), upper(:)
+      integer, intent(in) :: dim
+      type(status_t), intent(inout) :: status
+      integer :: k
+      do k = 1, dim
+         if (.not. (upper(k) > lower(k))) then
+            call status%fail(where//': variable upper('//int_text(k)//') must be > lower('//int_text(k)//') = '// &
+                             real_text(lower(k))//', got '//real_text(upper(k)))
+            return
+         end if
+      end do
+   end subroutine check_upper_above_lower
 
    !> Fail with "<where>: variable <variable> must be <range>, got <value>" unless `value` is finite and
    !> inside the range given by the optional bounds.

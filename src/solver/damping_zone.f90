@@ -66,10 +66,14 @@ contains
       class(damping_zones_t), intent(inout) :: self
       type(step_state_t), intent(inout) :: state
       real(rp), intent(inout) :: extent(3, 2)
-      real(rp) :: world(3), target(3), s, factor
+      real(rp) :: world(3), target(3, size(self%zones)), s, factor
       integer :: p, z, dim
       dim = state%grid%dim
       associate (particles => state%particles, frame => state%grid%frame)
+         ! the targets in the grid frame, once per step
+         do z = 1, size(self%zones)
+            target(1:dim, z) = frame%grid_vector(self%zones(z)%target_velocity(1:dim))
+         end do
          do p = 1, particles%count
             if (.not. self%fluid(particles%material(p))) cycle
             world(1:dim) = frame%world_point(particles%x(1:dim, p))
@@ -77,8 +81,7 @@ contains
                s = ramp_place(self%zones(z), world, dim)
                if (s < 0.0_rp) cycle
                factor = damping_factor(self%zones(z)%rate, s, state%dt)
-               target(1:dim) = frame%grid_vector(self%zones(z)%target_velocity(1:dim))
-               particles%v(1:dim, p) = target(1:dim) + (particles%v(1:dim, p) - target(1:dim)) * factor
+               particles%v(1:dim, p) = target(1:dim, z) + (particles%v(1:dim, p) - target(1:dim, z)) * factor
                exit
             end do
          end do

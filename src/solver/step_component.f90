@@ -2,9 +2,9 @@
 !> the scene declares it: the solver holds the scene's components as one list (step_component_factory)
 !> and calls each stage of every component in list order; a scene without such features has an empty
 !> list, and its step runs no test for them. Today: the inflow (fluid_inflow), the fluid volume
-!> correction (volume_correction) and the damping zones (damping_zone). A new one extends step_component_t, overrides the stages it uses
-!> (each default does nothing) and is added in step_component_factory (docs/conventions.md, "Where to
-!> add ...").
+!> correction (volume_correction) and the damping zones (damping_zone). A new one extends
+!> step_component_t, overrides the stages it uses (each default does nothing) and is added in
+!> step_component_factory (docs/conventions.md, "Where to add ...").
 !>
 !> The stages, in the order the step reaches them:
 !>   before_walls_move   t_n, before the moving walls are placed (an inlet's feeder gets its speed)

@@ -54,18 +54,27 @@ def analyse(scripts, folder):
     return pd.read_csv(table, comment="#").set_index("gauge"), report.stdout
 
 
+def run_flume(checks, flotsam, inputs, name, label, ranks, arguments=(), extra_group=None, **run_values):
+    """Run inputs/wave_flume.nml as `name` (with the &run values, the command-line `arguments`, and
+    `extra_group` appended to the scene): True if it ran to its end."""
+    flotsam.remove(name)
+    path = flotsam.scene(os.path.join(inputs, "wave_flume.nml"), name + ".nml", name, **run_values)
+    if extra_group:
+        with open(path, "a") as scene:
+            scene.write("\n" + extra_group + "\n")
+    started = time.time()
+    result = flotsam.run(path, ranks, "--overwrite", *arguments, timeout=7200)
+    seconds = time.time() - started
+    return checks.check(result.returncode == 0, f"{label}: run on {ranks} ranks ({seconds:.0f} s)",
+                        result.stderr[-2000:])
+
+
 def run_long(checks, flotsam, inputs, scripts, ranks):
     for order in (2, 1):
         name = f"wave_flume_order{order}"
-        flotsam.remove(name)
-        path = flotsam.scene(os.path.join(inputs, "wave_flume.nml"), name + ".nml", name)
-        started = time.time()
-        result = flotsam.run(path, ranks, "--overwrite", "--set", f"&wall name = 'paddle', wave_order = {order} /",
-                             timeout=7200)
-        seconds = time.time() - started
         label = f"order {order}"
-        if not checks.check(result.returncode == 0, f"{label}: run on {ranks} ranks ({seconds:.0f} s)",
-                            result.stderr[-2000:]):
+        if not run_flume(checks, flotsam, inputs, name, label, ranks,
+                         arguments=("--set", f"&wall name = 'paddle', wave_order = {order} /")):
             continue
         table, text = analyse(scripts, flotsam.path(name))
         print(text, end="", flush=True)
@@ -97,16 +106,8 @@ def run_absorbing(checks, flotsam, inputs, scripts, ranks):
     """The flume with and without a damping zone at its far end: the reflection coefficient at the gauges."""
     for zoned in (True, False):
         name = "wave_flume_" + ("damped" if zoned else "reflecting")
-        flotsam.remove(name)
-        path = flotsam.scene(os.path.join(inputs, "wave_flume.nml"), name + ".nml", name,
-                             end_time=f"{ABSORBING['end_time']}")
-        if zoned:
-            with open(path, "a") as scene:
-                scene.write("\n" + ABSORBING["zone"] + "\n")
-        started = time.time()
-        result = flotsam.run(path, ranks, "--overwrite", timeout=7200)
-        seconds = time.time() - started
-        if not checks.check(result.returncode == 0, f"{name}: run on {ranks} ranks ({seconds:.0f} s)", result.stderr[-2000:]):
+        if not run_flume(checks, flotsam, inputs, name, name, ranks, extra_group=ABSORBING["zone"] if zoned else None,
+                         end_time=f"{ABSORBING['end_time']}"):
             continue
         start, end = ABSORBING["window"]
         report = subprocess.run([sys.executable, os.path.join(scripts, "wave_gauges.py"), flotsam.path(name),

@@ -8,7 +8,7 @@ module damping_zone_group
    use kinds, only: rp, name_len
    use error_status, only: status_t
    use input_text, only: int_text, real_text, real_list_text, quoted, quoted_list, group_context, ordinal
-   use input_checks, only: check_real, check_name, name_detail
+   use input_checks, only: check_real, check_upper_above_lower, check_name, name_detail
    use scene_variables, only: variable_info_t, text_len, take_text
    use grid_group, only: grid_spec_t
    implicit none
@@ -125,13 +125,8 @@ contains
          end do
          call check_real(where, 'rate', zone%rate, status)
          if (.not. status%ok) return
-         do k = 1, grid%dim
-            if (zone%upper(k) <= zone%lower(k)) then
-               call status%fail(where//': variable upper('//int_text(k)//') must be > lower('//int_text(k)//') = '// &
-                                real_text(zone%lower(k))//', got '//real_text(zone%upper(k)))
-               return
-            end if
-         end do
+         call check_upper_above_lower(where, zone%lower, zone%upper, grid%dim, status)
+         if (.not. status%ok) return
          if (zone%rate <= 0.0_rp) then
             call status%fail(where//': variable rate must be > 0 [1/s] (the relaxation rate at the outer face), got '// &
                              real_text(zone%rate))
